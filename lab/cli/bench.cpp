@@ -1,0 +1,221 @@
+#include "lab/cli/bench.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <numbers>
+#include <ostream>
+#include <stdexcept>
+
+#include "lab/core/simulation.hpp"
+
+namespace rocklab {
+
+namespace {
+
+// The scene of ../shared/peers/README.md.
+constexpr double kYoung = 70e9;  // Pa
+constexpr double kPoisson = 0.25;
+constexpr double kDensity = 2650.0;  // kg/m^3
+constexpr double kFriction = 0.5;    // particle-particle; walls are frictionless
+constexpr double kRestitution = 0.5;
+constexpr double kTimeStep = 1.9e-7;  // s, 20% of the Rayleigh time of r = 0.9 mm
+constexpr double kStrainRate = 1.0;   // 1/s, each wall moves in at edot * L / 2
+
+// The damping ratio that gives restitution e for a linear dashpot; with Tsuji's Hertz
+// dashpot the peers use the same beta (LIGGGHTS and Yade).
+double dampingRatio(double e) {
+  const double l = std::log(e);
+  return -l / std::sqrt(l * l + std::numbers::pi * std::numbers::pi);
+}
+
+Simulation<3> makeScene(const Packing<3>& p, double friction, const SimulationConfig& cfg) {
+  Material sphere;
+  sphere.name = "sphere";
+  sphere.density = kDensity;
+  sphere.young = kYoung;
+  sphere.poisson = kPoisson;
+  sphere.friction = friction;
+  sphere.damping_ratio = dampingRatio(kRestitution);
+  Material wall = sphere;
+  wall.name = "wall";
+  wall.friction = 0.0;
+  MaterialTable mats;
+  mats.add(sphere);
+  const auto wall_material = mats.add(wall);
+  Simulation<3> sim(mats, cfg);
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    ParticleSpec<3> s;
+    s.position = p.centers[i];
+    s.radius = p.radii[i];
+    s.density = kDensity;
+    sim.particles().add(s);
+  }
+  for (int d = 0; d < 3; ++d) {
+    Wall<3> lo, hi;
+    lo.name = std::string(1, "xyz"[d]) + "min";
+    hi.name = std::string(1, "xyz"[d]) + "max";
+    lo.normal = Eigen::Vector3d::Unit(d);
+    lo.point = p.lo;
+    hi.normal = -Eigen::Vector3d::Unit(d);
+    hi.point = p.hi;
+    lo.material = hi.material = wall_material;
+    sim.addWall(lo);
+    sim.addWall(hi);
+  }
+  return sim;
+}
+
+// Box extents from the six walls (xmin, xmax, ymin, ymax, zmin, zmax in that order).
+Eigen::Vector3d boxExtent(const Simulation<3>& sim) {
+  Eigen::Vector3d e;
+  for (int d = 0; d < 3; ++d) e[d] = sim.wall(2 * d + 1).point[d] - sim.wall(2 * d).point[d];
+  return e;
+}
+
+double faceArea(const Eigen::Vector3d& extent, int axis) {
+  return extent[(axis + 1) % 3] * extent[(axis + 2) % 3];
+}
+
+double meanWallStress(const Simulation<3>& sim) {
+  const Eigen::Vector3d e = boxExtent(sim);
+  double s = 0.0;
+  for (int w = 0; w < 6; ++w) s += sim.wall(w).normalStress(faceArea(e, w / 2));
+  return s / 6.0;
+}
+
+}  // namespace
+
+Packing<3> benchPacking(std::size_t n, std::uint64_t seed, int threads) {
+  PackingSpec spec;
+  spec.count = n;
+  spec.sizes = SizeDistribution::uniform(1.8e-3, 2.2e-3);
+  spec.porosity = 0.5;  // loose: no contact forces yet, whatever the box size
+  spec.seed = seed;
+  spec.threads = threads;
+  const Packing<3> loose = generatePacking<3>(spec);
+
+  // Servo all six walls to 1 MPa with friction 0.1 (the peers' preparation).
+  SimulationConfig cfg;
+  cfg.contact_law = "hertz";
+  cfg.local_damping = 0.4;
+  cfg.threads = threads;
+  cfg.track_energy = false;
+  Simulation<3> sim = makeScene(loose, 0.1, cfg);
+  constexpr double kTarget = 1e6;
+  const double max_speed = 1e-3 * 0.9e-3 / kTimeStep;
+  for (int w = 0; w < 6; ++w) {
+    ServoControl& s = sim.wall(w).servo;
+    s.enabled = true;
+    s.target_stress = kTarget;
+    s.alpha = 0.3;
+    s.max_speed = max_speed;
+    s.area = faceArea(boxExtent(sim), w / 2);
+  }
+  bool settled = false;
+  for (int k = 0; k < 200000 && !settled; ++k) {
+    const Eigen::Vector3d e = boxExtent(sim);
+    for (int w = 0; w < 6; ++w) sim.wall(w).servo.area = faceArea(e, w / 2);
+    sim.step();
+    if (k % 200 == 199) {
+      settled = sim.unbalancedForceRatio() < 0.01;
+      for (int w = 0; w < 6; ++w) {
+        settled &= std::abs(sim.wall(w).normalStress(faceArea(e, w / 2)) / kTarget - 1.0) < 0.02;
+      }
+    }
+  }
+  if (!settled) {
+    throw std::runtime_error(
+        "the generated benchmark packing did not settle at 1 MPa in 200000 "
+        "steps; pass a packing file with --packing");
+  }
+  Packing<3> dense;
+  for (int d = 0; d < 3; ++d) {
+    dense.lo[d] = sim.wall(2 * d).point[d];
+    dense.hi[d] = sim.wall(2 * d + 1).point[d];
+  }
+  const auto& P = sim.particles();
+  dense.centers.resize(P.size());
+  dense.radii.resize(P.size());
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    dense.centers[P.slot_of[i]] = P.pos[i];
+    dense.radii[P.slot_of[i]] = P.radius[i];
+  }
+  return dense;
+}
+
+BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int threads) {
+  SimulationConfig cfg;
+  cfg.contact_law = "hertz";
+  cfg.skin = options.skin;
+  cfg.timestep.automatic = false;
+  cfg.timestep.fixed_dt = kTimeStep;
+  cfg.threads = threads;
+  cfg.track_energy = options.energy;
+  Simulation<3> sim = makeScene(packing, kFriction, cfg);
+  const Eigen::Vector3d extent = boxExtent(sim);
+  for (int w = 0; w < 6; ++w) {
+    sim.wall(w).velocity = kStrainRate * extent[w / 2] / 2.0 * sim.wall(w).normal;
+  }
+  sim.run(options.warmup);
+
+  BenchResult r;
+  r.threads = threads;
+  r.particles = sim.particles().size();
+  r.steps = options.steps;
+  r.coordination_start = sim.coordinationNumber();
+  r.wall_stress_start = meanWallStress(sim);
+  const std::uint64_t rebuilds = sim.contacts().rebuilds;
+  const auto t0 = std::chrono::steady_clock::now();
+  sim.run(options.steps);
+  const auto t1 = std::chrono::steady_clock::now();
+  r.seconds = std::chrono::duration<double>(t1 - t0).count();
+  r.particle_steps_per_second =
+      static_cast<double>(r.particles) * static_cast<double>(r.steps) / r.seconds;
+  r.coordination_end = sim.coordinationNumber();
+  r.wall_stress_end = meanWallStress(sim);
+  r.rebuilds = sim.contacts().rebuilds - rebuilds;
+  r.state_hash = sim.stateHash();
+  return r;
+}
+
+void printBench(std::ostream& out, const std::vector<BenchResult>& results, bool json,
+                const std::string& source) {
+  if (json) {
+    out << "{\n  \"scene\": \"peers standard (Hertz-Mindlin, 6 walls)\",\n  \"packing\": \""
+        << source << "\",\n  \"time_step_s\": " << kTimeStep << ",\n  \"runs\": [\n";
+    for (std::size_t k = 0; k < results.size(); ++k) {
+      const BenchResult& r = results[k];
+      out << "    {\"threads\": " << r.threads << ", \"particles\": " << r.particles
+          << ", \"steps\": " << r.steps << ", \"seconds\": " << r.seconds
+          << ", \"particle_steps_per_second\": " << r.particle_steps_per_second
+          << ", \"coordination_start\": " << r.coordination_start
+          << ", \"coordination_end\": " << r.coordination_end
+          << ", \"wall_stress_start_Pa\": " << r.wall_stress_start
+          << ", \"wall_stress_end_Pa\": " << r.wall_stress_end << ", \"rebuilds\": " << r.rebuilds
+          << ", \"state_hash\": \"" << std::hex << r.state_hash << std::dec << "\"}"
+          << (k + 1 < results.size() ? "," : "") << "\n";
+    }
+    out << "  ]\n}\n";
+    return;
+  }
+  out << "rocklab bench: " << source << ", Hertz-Mindlin, dt = " << kTimeStep << " s\n";
+  out << std::left << std::setw(8) << "threads" << std::setw(10) << "N" << std::setw(8) << "steps"
+      << std::setw(11) << "seconds" << std::setw(20) << "particle-steps/s" << std::setw(9)
+      << "Z start" << std::setw(7) << "Z end" << std::setw(20) << "wall stress (MPa)"
+      << std::setw(10) << "rebuilds"
+      << "state hash\n";
+  for (const BenchResult& r : results) {
+    std::ostringstream stress;
+    stress << std::fixed << std::setprecision(3) << r.wall_stress_start / 1e6 << " -> "
+           << r.wall_stress_end / 1e6;
+    out << std::left << std::setw(8) << r.threads << std::setw(10) << r.particles << std::setw(8)
+        << r.steps << std::setw(11) << std::fixed << std::setprecision(3) << r.seconds
+        << std::setw(20) << std::scientific << std::setprecision(3) << r.particle_steps_per_second
+        << std::fixed << std::setprecision(3) << std::setw(9) << r.coordination_start
+        << std::setw(7) << r.coordination_end << std::setw(20) << stress.str() << std::setw(10)
+        << r.rebuilds << std::hex << r.state_hash << std::dec << "\n";
+  }
+}
+
+}  // namespace rocklab

@@ -1,0 +1,177 @@
+// The `rocklab` command.
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <iostream>
+#include <sstream>
+
+#include "lab/cli/bench.hpp"
+#include "lab/cli/build_info.hpp"
+#include "lab/core/contact_laws.hpp"
+#include "lab/core/packing_io.hpp"
+
+namespace {
+
+std::string versionLine() {
+  std::ostringstream s;
+  s << "rocklab " << rocklab::kVersion << " (git " << rocklab::kGitRevision << ", "
+    << rocklab::kBuildType << " build" << (*rocklab::kBuildFlags ? ", " : "")
+    << rocklab::kBuildFlags << ")";
+  return s.str();
+}
+
+int runBenchCommand(rocklab::BenchOptions o, bool json) {
+  using namespace rocklab;
+  Packing<3> packing;
+  std::string source;
+  if (!o.packing.empty()) {
+    if (packingFileDimension(o.packing) != 3) {
+      throw std::runtime_error(o.packing + ": the benchmark scene is 3D; this packing is 2D");
+    }
+    packing = readPacking<3>(o.packing);
+    source = o.packing;
+  } else {
+    if (!json)
+      std::cerr << "generating a packing of " << o.n << " spheres (seed " << o.seed
+                << ") at 1 MPa ...\n";
+    packing = benchPacking(o.n, o.seed, o.threads.front());
+    source = "generated (N = " + std::to_string(o.n) + ", seed " + std::to_string(o.seed) + ")";
+    if (!o.save_packing.empty()) {
+      writePacking<3>(o.save_packing, packing,
+                      "rocklab bench packing, radii uniform [0.9, 1.1] mm, 1 MPa, seed " +
+                          std::to_string(o.seed));
+    }
+  }
+  std::vector<BenchResult> results;
+  for (int t : o.threads) results.push_back(runBench(packing, o, t));
+  printBench(std::cout, results, json, source);
+  return 0;
+}
+
+int runPackCommand(int dim, rocklab::PackingSpec spec, const std::string& dist, double dmin_mm,
+                   double dmax_mm, double dmean_mm, double dstd_mm, double phi_mean, double phi_std,
+                   const std::string& out) {
+  using namespace rocklab;
+  const double mm = 1e-3;
+  if (dist == "uniform") {
+    spec.sizes = SizeDistribution::uniform(dmin_mm * mm, dmax_mm * mm);
+  } else if (dist == "normal") {
+    spec.sizes = SizeDistribution::normal(dmean_mm * mm, dstd_mm * mm, dmin_mm * mm, dmax_mm * mm);
+  } else {
+    spec.sizes = SizeDistribution::phiGaussian(phi_mean, phi_std, dmin_mm * mm, dmax_mm * mm);
+  }
+  PackingReport report;
+  std::ostringstream comment;
+  comment << "rocklab pack: " << dim << "D, " << spec.count << " particles, "
+          << spec.sizes.describe() << ", target porosity " << spec.porosity << ", seed "
+          << spec.seed;
+  auto finish = [&](const auto& packing) {
+    comment << "\nporosity " << packing.porosity() << ", max overlap/r " << report.max_overlap
+            << ", coordination " << report.coordination << ", " << report.steps << " steps";
+    std::cout << comment.str() << "\n";
+  };
+  if (dim == 2) {
+    const auto p = generatePacking<2>(spec, &report);
+    finish(p);
+    writePacking<2>(out, p, comment.str());
+  } else {
+    const auto p = generatePacking<3>(spec, &report);
+    finish(p);
+    writePacking<3>(out, p, comment.str());
+  }
+  std::cout << "wrote " << out << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // The chosen subcommand's work, run after parsing so errors are reported uniformly.
+  std::function<int()> action;
+  CLI::App app{
+      "rocklab: a virtual rock laboratory. Runs laboratory protocols on numerical rock "
+      "made of particles (DEM)."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", versionLine());
+
+  app.add_subcommand("version", "Print the version, git revision and build type")->callback([&] {
+    action = [] {
+      std::cout << versionLine() << "\n";
+      return 0;
+    };
+  });
+
+  app.add_subcommand("laws", "List the contact laws and the material parameters they read")
+      ->callback([&] {
+        action = [] {
+          for (const auto* law : rocklab::contactLaws()) {
+            std::cout << law->name << ": " << law->doc << "\n  reads: " << law->material_keys
+                      << "\n";
+          }
+          return 0;
+        };
+      });
+
+  rocklab::BenchOptions bench;
+  bool json = false;
+  auto* b = app.add_subcommand(
+      "bench",
+      "Run the benchmark scene shared with LIGGGHTS and Yade (../shared/peers): Hertz-Mindlin, "
+      "six walls closing in, dt 1.9e-7 s; prints particle-steps per second per thread count");
+  b->add_option("--packing", bench.packing, "Packing file (N, walls, x y z r per line, metres)")
+      ->check(CLI::ExistingFile);
+  b->add_option("--n", bench.n, "Spheres in the generated packing (without --packing)")
+      ->check(CLI::Range(2, 100000000));
+  b->add_option("--steps", bench.steps, "Timed steps")->check(CLI::Range(1, 1000000000));
+  b->add_option("--warmup", bench.warmup, "Untimed steps before");
+  b->add_option("--threads", bench.threads, "Thread counts to run, e.g. --threads 1,2")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1024));
+  b->add_option("--skin-m", bench.skin, "Verlet skin (m)")->check(CLI::Range(1e-9, 1.0));
+  b->add_option("--seed", bench.seed, "Seed of the generated packing");
+  b->add_flag("--energy", bench.energy, "Track contact dissipation (the peers do not)");
+  b->add_option("--save-packing", bench.save_packing, "Write the generated packing to this file");
+  b->add_flag("--json", json, "Print JSON");
+  b->callback([&] { action = [&] { return runBenchCommand(bench, json); }; });
+
+  int dim = 3;
+  rocklab::PackingSpec spec;
+  std::string dist = "uniform", out;
+  double dmin = 1.8, dmax = 2.2, dmean = 2.0, dstd = 0.1, phi_mean = -1.0, phi_std = 0.1;
+  auto* p = app.add_subcommand(
+      "pack",
+      "Generate a packing: random placement, then radius expansion in a fixed box to a "
+      "target porosity");
+  p->add_option("--dim", dim, "2 (disks) or 3 (spheres)")->check(CLI::IsMember({2, 3}));
+  p->add_option("--n", spec.count, "Particles")->check(CLI::Range(1, 50000000));
+  p->add_option("--dist", dist, "Size distribution: uniform, normal or phi (Gaussian in phi)")
+      ->check(CLI::IsMember({"uniform", "normal", "phi"}));
+  p->add_option("--d-min-mm", dmin, "Smallest diameter (mm)")->check(CLI::PositiveNumber);
+  p->add_option("--d-max-mm", dmax, "Largest diameter (mm)")->check(CLI::PositiveNumber);
+  p->add_option("--d-mean-mm", dmean, "Mean diameter, normal distribution (mm)");
+  p->add_option("--d-std-mm", dstd, "Diameter standard deviation, normal distribution (mm)");
+  p->add_option("--phi-mean", phi_mean, "Mean of phi = -log2(d / 1 mm), phi distribution");
+  p->add_option("--phi-std", phi_std, "Standard deviation of phi, phi distribution");
+  p->add_option("--porosity", spec.porosity, "Target porosity (-)")->check(CLI::Range(0.01, 0.99));
+  p->add_option("--thickness-m", spec.thickness, "Disk thickness in 2D (m)");
+  p->add_option("--seed", spec.seed, "Random seed");
+  p->add_option("--threads", spec.threads, "Threads")->check(CLI::Range(1, 1024));
+  p->add_option("--out", out, "Output packing file")->required();
+  p->callback([&] {
+    action = [&] {
+      return runPackCommand(dim, spec, dist, dmin, dmax, dmean, dstd, phi_mean, phi_std, out);
+    };
+  });
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    return action ? action() : 0;
+  } catch (const std::exception& e) {
+    std::cerr << "rocklab: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,115 @@
+#pragma once
+// The shared, stateless contact kernel.
+//
+// A law (contact_law_*.hpp) supplies the normal elastic force and the tangent stiffnesses
+// and dashpot coefficients at an overlap (`evaluate`); `contactForce` adds the
+// dashpots, the incremental tangential spring with Coulomb sliding, and objectivity.
+// Sign conventions: n points from particle i to particle j (or from a particle to a wall);
+// forces returned act on j, i receives the opposite.
+
+#include <algorithm>
+#include <cmath>
+
+#include "lab/core/dim.hpp"
+
+namespace rocklab {
+
+// What a law returns at an overlap: elastic normal force (N, repulsive positive), tangent
+// normal and shear stiffness (N/m) and dashpot coefficients (N s/m).
+struct LawState {
+  double fn_elastic;
+  double kn;
+  double ks;
+  double cn;
+  double cs;
+};
+
+// Energy dissipated in one contact during one step (J).
+struct ContactDissipation {
+  double friction = 0.0;
+  double viscous = 0.0;
+};
+
+template <int D>
+struct ContactResult {
+  Vec<D> force;       // on j
+  Ang<D> n_cross_ft;  // n x (tangential force on j), to build torques with the lever arms
+  double kn;          // tangent normal stiffness, for servo gains and the time step
+  double cn;          // normal dashpot coefficient, for servo gains
+};
+
+// Relative kinematics of one contact.
+template <int D>
+struct ContactKinematics {
+  Vec<D> n;        // unit normal from i to j
+  double overlap;  // > 0
+  Vec<D> vc;       // velocity of j's contact point relative to i's
+  double spin_n;   // mean spin of the two bodies about n (3D twist; 0 in 2D)
+  double rstar;    // effective radius
+  double mstar;    // effective mass
+};
+
+// The shared contact kernel. `fs` is the contact's tangential spring force on j (its
+// history); it is rotated with the contact (objectivity), incremented by -ks * vt * dt,
+// and capped at mu * Fn (Coulomb). When sliding, the shear dashpot is inactive so that
+// |Ft| <= mu Fn holds exactly.
+template <int D, class Law, bool kTrackEnergy>
+inline ContactResult<D> contactForce(const typename Law::Params& p, const ContactKinematics<D>& k,
+                                     Vec<D>& fs, double dt, ContactDissipation& diss) {
+  const LawState s = Law::evaluate(p, k.overlap, k.rstar, k.mstar);
+  const Vec<D>& n = k.n;
+  const double vn = k.vc.dot(n);
+  const Vec<D> vt = k.vc - vn * n;
+  const double fn = s.fn_elastic - s.cn * vn;
+
+  // Keep the stored spring force in the current tangent plane with its magnitude, and turn
+  // it with the bodies' spin about the normal, so a rigidly rotated contact keeps its
+  // force (Cundall & Strack 1979; cf. Yade ScGeom::rotate).
+  const double fs2_old = fs.squaredNorm();
+  if (fs2_old > 0.0) {
+    if constexpr (D == 3) {
+      fs += (dt * k.spin_n) * n.cross(fs);
+    }
+    fs -= fs.dot(n) * n;
+    const double fs2_new = fs.squaredNorm();
+    if (fs2_new > 0.0) fs *= std::sqrt(fs2_old / fs2_new);
+  }
+  const Vec<D> fs_rotated = fs;
+  fs -= (s.ks * dt) * vt;
+
+  Vec<D> ft;
+  const double limit = p.mu * std::max(s.fn_elastic, 0.0);
+  const double fs2 = fs.squaredNorm();
+  if (fs2 > limit * limit) {
+    fs *= fs2 > 0.0 ? limit / std::sqrt(fs2) : 0.0;
+    ft = fs;
+    if constexpr (kTrackEnergy) {
+      // Slip = relative displacement minus the elastic spring extension increment.
+      Vec<D> slip = vt * dt;
+      if (s.ks > 0.0) slip += (fs - fs_rotated) / s.ks;
+      diss.friction -= fs.dot(slip);
+    }
+  } else {
+    ft = fs - s.cs * vt;
+    if constexpr (kTrackEnergy) diss.viscous += s.cs * vt.squaredNorm() * dt;
+  }
+  if constexpr (kTrackEnergy) diss.viscous += s.cn * vn * vn * dt;
+
+  ContactResult<D> r;
+  r.force = fn * n + ft;
+  r.n_cross_ft = cross(n, ft);
+  r.kn = s.kn;
+  r.cn = s.cn;
+  return r;
+}
+
+// Strain energy stored in a contact: the law's normal energy plus the shear spring's.
+template <class Law>
+inline double contactStrainEnergy(const typename Law::Params& p, double overlap, double rstar,
+                                  double shear_force2, double mstar) {
+  const LawState s = Law::evaluate(p, overlap, rstar, mstar);
+  const double es = s.ks > 0.0 ? 0.5 * shear_force2 / s.ks : 0.0;
+  return Law::normalEnergy(p, overlap, rstar) + es;
+}
+
+}  // namespace rocklab

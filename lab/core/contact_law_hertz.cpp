@@ -1,0 +1,54 @@
+#include "lab/core/contact_law_hertz.hpp"
+
+#include "lab/core/contact_laws.hpp"
+#include "lab/core/contact_model_impl.hpp"
+#include "lab/core/errors.hpp"
+
+namespace rocklab {
+
+namespace {
+
+void validate(const MaterialTable& m) {
+  for (const Material& a : m.all()) {
+    const std::string where = "material '" + a.name + "' (hertz contact law)";
+    requireRange(where, "young", a.young, 0.0, true, INFINITY, true, "Pa");
+    requireRange(where, "poisson", a.poisson, -1.0, true, 0.5, false, "-");
+    requireRange(where, "friction", a.friction, 0.0, false, INFINITY, true, "-");
+    requireRange(where, "damping_ratio", a.damping_ratio, 0.0, false, 1.0, true, "-");
+    requireRange(where, "density", a.density, 0.0, true, INFINITY, true, "kg/m^3");
+  }
+}
+
+// Effective moduli of two elastic bodies in contact (Johnson 1985, ch. 4 and 7):
+// 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 and 1/G* = (2-nu1)/G1 + (2-nu2)/G2.
+HertzParams mix(const MaterialTable& m, std::uint16_t a, std::uint16_t b) {
+  const Material& A = m[a];
+  const Material& B = m[b];
+  const double ga = A.young / (2.0 * (1.0 + A.poisson)), gb = B.young / (2.0 * (1.0 + B.poisson));
+  HertzParams p;
+  p.estar =
+      1.0 / ((1.0 - A.poisson * A.poisson) / A.young + (1.0 - B.poisson * B.poisson) / B.young);
+  p.gstar = 1.0 / ((2.0 - A.poisson) / ga + (2.0 - B.poisson) / gb);
+  p.mu = m.friction(a, b);
+  p.damp = 2.0 * std::sqrt(5.0 / 6.0) * m.dampingRatio(a, b);
+  return p;
+}
+
+template <int D>
+std::unique_ptr<ContactModel<D>> make(const MaterialTable& m) {
+  return bindContactLaw<D, HertzLaw>("hertz", PairTable<HertzParams>(m, mix), m.all());
+}
+
+}  // namespace
+
+const ContactLawEntry kHertzLawEntry{
+    "hertz",
+    "Hertz normal force, Mindlin no-slip tangential stiffness, Coulomb friction, Tsuji "
+    "dashpots by damping ratio (2D disks use the sphere formula, as PFC2D does)",
+    "young (Pa), poisson (-), friction (-), damping_ratio (-), density (kg/m^3)",
+    validate,
+    make<2>,
+    make<3>,
+};
+
+}  // namespace rocklab

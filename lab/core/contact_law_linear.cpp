@@ -1,0 +1,54 @@
+#include "lab/core/contact_law_linear.hpp"
+
+#include "lab/core/contact_laws.hpp"
+#include "lab/core/contact_model_impl.hpp"
+#include "lab/core/errors.hpp"
+
+namespace rocklab {
+
+namespace {
+
+void validate(const MaterialTable& m) {
+  for (const Material& a : m.all()) {
+    const std::string where = "material '" + a.name + "' (linear contact law)";
+    requireRange(where, "kn", a.kn, 0.0, true, INFINITY, true, "N/m");
+    requireRange(where, "ks", a.ks, 0.0, false, INFINITY, true, "N/m");
+    requireRange(where, "friction", a.friction, 0.0, false, INFINITY, true, "-");
+    requireRange(where, "damping_ratio", a.damping_ratio, 0.0, false, 1.0, true, "-");
+    requireRange(where, "density", a.density, 0.0, true, INFINITY, true, "kg/m^3");
+  }
+}
+
+// Particle springs act in series at a contact, as in PFC (Itasca 1999):
+// k = k1 k2 / (k1 + k2); a shear spring of 0 on either side gives no shear stiffness.
+double series(double a, double b) {
+  return a > 0.0 && b > 0.0 ? a * b / (a + b) : 0.0;
+}
+
+LinearParams mix(const MaterialTable& m, std::uint16_t a, std::uint16_t b) {
+  LinearParams p;
+  p.kn = series(m[a].kn, m[b].kn);
+  p.ks = series(m[a].ks, m[b].ks);
+  p.mu = m.friction(a, b);
+  p.damp = 2.0 * m.dampingRatio(a, b);
+  return p;
+}
+
+template <int D>
+std::unique_ptr<ContactModel<D>> make(const MaterialTable& m) {
+  return bindContactLaw<D, LinearLaw>("linear", PairTable<LinearParams>(m, mix), m.all());
+}
+
+}  // namespace
+
+const ContactLawEntry kLinearLawEntry{
+    "linear",
+    "linear normal and shear springs in series per contact, Coulomb friction, dashpots by "
+    "critical damping ratio",
+    "kn (N/m), ks (N/m), friction (-), damping_ratio (-), density (kg/m^3)",
+    validate,
+    make<2>,
+    make<3>,
+};
+
+}  // namespace rocklab

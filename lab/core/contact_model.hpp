@@ -1,0 +1,99 @@
+#pragma once
+// A contact law bound to a scene's materials: pair parameters mixed once into a table, and
+// the force loops over particle pairs and particle-wall contacts, compiled per law.
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lab/core/contact_kernels.hpp"
+#include "lab/core/contacts.hpp"
+#include "lab/core/material.hpp"
+#include "lab/core/particles.hpp"
+#include "lab/core/walls.hpp"
+
+namespace rocklab {
+
+// Rows per block of the force loop. Per-block partial sums are added in block order, so
+// energy and guard totals do not depend on the number of threads.
+inline constexpr std::size_t kBlockRows = 256;
+
+// Everything one force pass reads and writes.
+template <int D>
+struct ContactPass {
+  ParticleStore<D>& particles;
+  ContactStore<D>& contacts;
+  std::vector<Wall<D>>& walls;
+  double dt;
+  bool threaded;  // store per-pair results and gather, instead of scattering
+  int threads;
+  bool track_energy;
+  double overlap_limit;  // overlap / smaller radius beyond which the guard trips
+
+  // Out: energy dissipated in contacts this step (J), and whether an overlap exceeded the
+  // limit.
+  double friction = 0.0;
+  double viscous = 0.0;
+  bool overlap_exceeded = false;
+};
+
+// Per-pair results of the threaded pass, gathered per particle afterwards.
+template <int D>
+struct PairBuffers {
+  std::vector<std::uint8_t> touching;
+  std::vector<Vec<D>> force;
+  std::vector<Ang<D>> torque_i, torque_j;
+  std::vector<double> block_friction, block_viscous;
+  std::vector<std::uint8_t> block_over;
+};
+
+template <int D>
+class ContactModel {
+ public:
+  virtual ~ContactModel() = default;
+  virtual std::string_view law() const = 0;
+  // Pair and wall forces of one step, added to the particles' forces and torques.
+  virtual void computeForces(ContactPass<D>& pass) = 0;
+  // Tangent normal and shear stiffness (N/m) of a contact at an overlap.
+  virtual std::pair<double, double> stiffness(std::uint16_t mi, std::uint16_t mj, double overlap,
+                                              double rstar, double mstar) const = 0;
+  // Elastic normal force (N) of a contact at an overlap.
+  virtual double normalForce(std::uint16_t mi, std::uint16_t mj, double overlap,
+                             double rstar) const = 0;
+  // Elastic energy stored in a contact (J).
+  virtual double strainEnergy(std::uint16_t mi, std::uint16_t mj, double overlap, double rstar,
+                              double mstar, double shear_force2) const = 0;
+  // Critical step (s) of a particle that touches nothing yet: it bounds the step before
+  // contacts form (linear: sqrt(m / kn) of a contact with its own kind; Hertz: the Rayleigh
+  // wave time across the particle).
+  virtual double freeParticleStep(std::uint16_t material, double radius, double mass,
+                                  double inertia) const = 0;
+};
+
+// Pair parameters of every material pair, mixed once.
+template <class Params>
+class PairTable {
+ public:
+  PairTable() = default;
+  template <class Mix>
+  PairTable(const MaterialTable& m, Mix mix) : n_(m.size()), p_(n_ * n_) {
+    for (std::size_t a = 0; a < n_; ++a) {
+      for (std::size_t b = 0; b < n_; ++b) {
+        p_[a * n_ + b] = mix(m, static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(b));
+      }
+    }
+  }
+  const Params& operator()(std::uint16_t a, std::uint16_t b) const { return p_[a * n_ + b]; }
+
+ private:
+  std::size_t n_ = 0;
+  std::vector<Params> p_;
+};
+
+template <int D, class Law>
+std::unique_ptr<ContactModel<D>> bindContactLaw(std::string_view name,
+                                                PairTable<typename Law::Params> table,
+                                                std::vector<Material> materials);
+
+}  // namespace rocklab

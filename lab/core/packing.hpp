@@ -1,0 +1,78 @@
+#pragma once
+// Packing generation: particle sizes from a distribution, random placement, and radius
+// expansion in a fixed box to a target porosity (the PFC radius-expansion method).
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "lab/core/dim.hpp"
+#include "lab/core/random.hpp"
+
+namespace rocklab {
+
+struct SizeDistribution {
+  enum class Kind { Uniform, Normal, PhiGaussian };
+  Kind kind = Kind::Uniform;
+  double d_min = 0.0;     // m; uniform: lower bound; normal and phi: draws below are redrawn
+  double d_max = 0.0;     // m; likewise the upper bound
+  double d_mean = 0.0;    // m, normal
+  double d_std = 0.0;     // m, normal
+  double phi_mean = 0.0;  // phi units, phi-Gaussian: phi = -log2(d / 1 mm)
+  double phi_std = 0.0;   // phi units
+
+  static SizeDistribution uniform(double d_min, double d_max);
+  static SizeDistribution normal(double mean, double std, double d_min, double d_max);
+  static SizeDistribution phiGaussian(double phi_mean, double phi_std, double d_min, double d_max);
+
+  // A diameter (m). Draws outside [d_min, d_max] are redrawn (truncated distributions).
+  double sample(Rng& rng) const;
+  // Throws InvalidParameter for impossible settings.
+  void validate() const;
+  std::string describe() const;
+};
+
+// phi = -log2(d / 1 mm) and back (Krumbein's phi scale of grain size).
+inline double phiOfDiameter(double d_m) {
+  return -std::log2(d_m / 1e-3);
+}
+inline double diameterOfPhi(double phi) {
+  return 1e-3 * std::exp2(-phi);
+}
+
+struct PackingSpec {
+  std::size_t count = 1000;
+  SizeDistribution sizes;
+  double porosity = 0.4;                  // -, target: 1 - particle volume / box volume
+  std::array<double, 3> aspect{1, 1, 1};  // box edge ratios
+  double thickness = 1.0;                 // m, 2D disk thickness
+  std::uint64_t seed = 1;
+  double friction = 0.0;  // -, during expansion (0 gives the densest packing)
+  int threads = 1;
+};
+
+template <int D>
+struct Packing {
+  Vec<D> lo = Vec<D>::Zero(), hi = Vec<D>::Zero();  // inner faces of the box walls
+  std::vector<Vec<D>> centers;
+  std::vector<double> radii;
+  double thickness = 1.0;
+
+  double boxVolume() const;
+  double solidVolume() const;
+  // Nominal porosity: 1 - sum of particle volumes / box volume (overlaps not removed).
+  double porosity() const { return 1.0 - solidVolume() / boxVolume(); }
+};
+
+struct PackingReport {
+  std::uint64_t steps = 0;
+  double max_overlap = 0.0;   // largest overlap / smaller radius at the end
+  double coordination = 0.0;  // mean contacts per particle at the end
+  double unbalanced = 0.0;    // unbalanced force ratio at the end
+};
+
+template <int D>
+Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report = nullptr);
+
+}  // namespace rocklab

@@ -1,0 +1,101 @@
+#pragma once
+// The particle store: hot per-particle state in structure-of-arrays form, cold metadata
+// apart, and generation-checked handles that survive reordering and detect stale ids.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "lab/core/dim.hpp"
+
+namespace rocklab {
+
+// A stable handle to a particle. `slot` names the particle for its whole life (contact
+// history and bonds are keyed by slots); `generation` changes when a slot is reused, so a
+// handle to a removed particle is detected instead of silently naming its successor.
+struct ParticleId {
+  std::uint32_t slot = 0;
+  std::uint32_t generation = 0;
+  friend bool operator==(const ParticleId&, const ParticleId&) = default;
+};
+
+class StaleParticleId : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+template <int D>
+struct ParticleSpec {
+  Vec<D> position = Vec<D>::Zero();
+  Vec<D> velocity = Vec<D>::Zero();
+  Ang<D> spin = angZero<Ang<D>>();
+  double radius = 0.0;
+  double density = 0.0;  // kg/m^3
+  bool fixed = false;    // infinite mass and inertia: moves only if its velocity is prescribed
+  std::uint16_t material = 0;
+  std::uint32_t groups = 0;  // bit mask of user group tags
+};
+
+template <int D>
+class ParticleStore {
+ public:
+  using V = Vec<D>;
+  using A = Ang<D>;
+
+  // Hot state: what the force and integration loops touch, contiguous per quantity.
+  std::vector<V> pos, vel, force;
+  std::vector<A> spin, torque;
+  std::vector<double> inv_mass, inv_inertia, radius;
+  std::vector<std::uint16_t> material;  // read in the contact loop to mix pair parameters
+
+  // Cold metadata.
+  std::vector<std::uint32_t> groups;
+  std::vector<std::uint32_t> slot_of;  // index -> slot
+
+  // 2D particles are disks extruded to this thickness (m); ignored in 3D.
+  double thickness = 1.0;
+
+  std::size_t size() const { return pos.size(); }
+
+  ParticleId add(const ParticleSpec<D>& spec);
+  void remove(ParticleId id);
+
+  bool valid(ParticleId id) const {
+    return id.slot < slot_generation_.size() && slot_generation_[id.slot] == id.generation &&
+           slot_index_[id.slot] != kNoIndex;
+  }
+  // Current array index of a particle; throws StaleParticleId for a removed particle.
+  std::size_t index(ParticleId id) const;
+  ParticleId id(std::size_t index) const {
+    const auto s = slot_of[index];
+    return {s, slot_generation_[s]};
+  }
+  std::size_t indexOfSlot(std::uint32_t slot) const { return slot_index_[slot]; }
+  std::size_t slotCapacity() const { return slot_index_.size(); }
+
+  double mass(std::size_t i) const { return inv_mass[i] > 0 ? 1.0 / inv_mass[i] : INFINITY; }
+  double volume(std::size_t i) const { return particleVolume<D>(radius[i], thickness); }
+
+  // Reorders every array so that new index k holds the particle that was at order[k].
+  void permute(const std::vector<std::uint32_t>& order);
+
+  // The slot bookkeeping, for checkpoints (one serializer visits it; see checkpoint.hpp).
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("thickness", thickness);
+    ar("pos", pos), ar("vel", vel), ar("force", force), ar("spin", spin), ar("torque", torque);
+    ar("inv_mass", inv_mass), ar("inv_inertia", inv_inertia), ar("radius", radius);
+    ar("material", material), ar("groups", groups), ar("slot_of", slot_of);
+    ar("slot_index", slot_index_), ar("slot_generation", slot_generation_);
+    ar("free_slots", free_slots_);
+  }
+
+ private:
+  static constexpr std::uint32_t kNoIndex = 0xffffffffu;
+  std::vector<std::uint32_t> slot_index_;       // slot -> index, kNoIndex when free
+  std::vector<std::uint32_t> slot_generation_;  // slot -> generation
+  std::vector<std::uint32_t> free_slots_;
+};
+
+}  // namespace rocklab

@@ -1,0 +1,897 @@
+#include "lab/core/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "lab/core/archive.hpp"
+#include "lab/core/contact_laws.hpp"
+#include "lab/core/errors.hpp"
+
+namespace rocklab {
+
+namespace {
+
+// Runs body(i, acc) over [0, n) in fixed blocks of kBlockRows and adds the blocks' partial
+// results in block order: the total is the same whatever the thread count.
+template <class Acc, class Body>
+Acc blockedSum(std::size_t n, int threads, Body body) {
+  const std::size_t blocks = (n + kBlockRows - 1) / kBlockRows;
+  std::vector<Acc> part(blocks);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::size_t b = 0; b < blocks; ++b) {
+    Acc a{};
+    const std::size_t end = std::min(n, (b + 1) * kBlockRows);
+    for (std::size_t i = b * kBlockRows; i < end; ++i) body(i, a);
+    part[b] = a;
+  }
+  Acc total{};
+  for (const Acc& a : part) total.merge(a);
+  return total;
+}
+
+double signOf(double v) {
+  return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0);
+}
+
+// PFC local damping (Itasca 1999; Cundall 1987): a force opposing each velocity component,
+// proportional to the unbalanced force, F_d = -alpha |F| sign(v), component by component.
+double localDamping(double f, double v, double alpha) {
+  return -alpha * std::abs(f) * signOf(v);
+}
+template <int R>
+Eigen::Matrix<double, R, 1> localDamping(const Eigen::Matrix<double, R, 1>& f,
+                                         const Eigen::Matrix<double, R, 1>& v, double alpha) {
+  Eigen::Matrix<double, R, 1> d;
+  for (int k = 0; k < R; ++k) d[k] = localDamping(f[k], v[k], alpha);
+  return d;
+}
+
+constexpr char kMagic[8] = {'R', 'K', 'L', 'B', 'C', 'K', 'P', 'T'};
+constexpr char kTrailer[8] = {'R', 'K', 'L', 'B', 'E', 'N', 'D', '!'};
+
+std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+template <class T>
+std::uint64_t hashVector(const std::vector<T>& v, std::uint64_t h) {
+  return v.empty() ? h : fnv1a(v.data(), v.size() * sizeof(T), h);
+}
+
+std::uint64_t packId(ParticleId id) {
+  return std::uint64_t{id.slot} << 32 | id.generation;
+}
+std::uint64_t pairKey(std::uint32_t a, std::uint32_t b) {
+  return a < b ? (std::uint64_t{a} << 32 | b) : (std::uint64_t{b} << 32 | a);
+}
+
+struct OverrideRow {
+  std::uint16_t a = 0, b = 0;
+  double friction = NAN, damping_ratio = NAN;  // NaN: not overridden
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("a", a), ar("b", b), ar("friction", friction), ar("damping_ratio", damping_ratio);
+  }
+};
+
+}  // namespace
+
+template <int D>
+Simulation<D>::Simulation(MaterialTable materials, SimulationConfig config)
+    : materials_(std::move(materials)), config_(std::move(config)) {}
+template <int D>
+Simulation<D>::~Simulation() = default;
+template <int D>
+Simulation<D>::Simulation(Simulation&&) noexcept = default;
+template <int D>
+Simulation<D>& Simulation<D>::operator=(Simulation&&) noexcept = default;
+
+template <int D>
+std::size_t Simulation<D>::addWall(Wall<D> w) {
+  const double len = w.normal.norm();
+  if (!(len > 0.0) || !std::isfinite(len)) {
+    throw std::invalid_argument("wall '" + w.name + "' needs a non-zero normal");
+  }
+  w.normal /= len;
+  walls_.push_back(std::move(w));
+  wall_prev_force_.push_back(V::Zero());
+  invalidateNeighbors();
+  return walls_.size() - 1;
+}
+
+template <int D>
+void Simulation<D>::scaleRadii(double factor) {
+  if (!(factor > 0.0)) throw std::invalid_argument("radius scale factor must be positive");
+  double rmax = 0.0;
+  for (double& r : particles_.radius) {
+    r *= factor;
+    rmax = std::max(rmax, r);
+  }
+  if (factor < 1.0) return;  // shrinking never brings surfaces closer
+  contacts_.radius_growth += (factor - 1.0) / factor * rmax;
+}
+
+template <int D>
+void Simulation<D>::setThreads(int threads) {
+  if (threads < 1) throw std::invalid_argument("thread count must be at least 1");
+  config_.threads = threads;
+}
+
+template <int D>
+void Simulation<D>::setFixedTimeStep(double dt) {
+  requireRange("time step", "dt", dt, 0.0, true, INFINITY, true, "s");
+  config_.timestep.automatic = false;
+  config_.timestep.fixed_dt = dt;
+  dt_ = dt;
+}
+
+template <int D>
+void Simulation<D>::prepare() {
+  const std::string where = "simulation settings";
+  requireRange(where, "local_damping", config_.local_damping, 0.0, false, 1.0, true, "-");
+  requireRange(where, "timestep.safety", config_.timestep.safety, 0.0, true, 1.0, false, "-");
+  requireRange(where, "timestep.update_interval", config_.timestep.update_interval, 1, false, 1e9,
+               false, "steps");
+  requireRange(where, "guard.overlap_limit", config_.guard.overlap_limit, 0.0, true, 1.0, false,
+               "-");
+  requireRange(where, "guard.energy_growth", config_.guard.energy_growth, 1.0, true, INFINITY, true,
+               "-");
+  requireRange(where, "skin", config_.skin, 0.0, false, INFINITY, true, "m");
+  if (particles_.size() == 0) throw std::invalid_argument("the scene has no particles");
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    if (particles_.material[i] >= materials_.size()) {
+      throw std::invalid_argument("particle " + std::to_string(i) + " names material " +
+                                  std::to_string(particles_.material[i]) + ", but only " +
+                                  std::to_string(materials_.size()) + " are defined");
+    }
+  }
+  for (const auto& w : walls_) {
+    if (w.material >= materials_.size()) {
+      throw std::invalid_argument("wall '" + w.name + "' names an undefined material");
+    }
+    if (w.servo.enabled) {
+      requireRange("wall '" + w.name + "' servo", "area", w.servo.area, 0.0, true, INFINITY, true,
+                   "m^2");
+      requireRange("wall '" + w.name + "' servo", "max_speed", w.servo.max_speed, 0.0, true,
+                   INFINITY, true, "m/s");
+      requireRange("wall '" + w.name + "' servo", "alpha", w.servo.alpha, 0.0, true, 1.0, false,
+                   "-");
+    }
+  }
+  if (!model_) model_ = makeContactModel<D>(config_.contact_law, materials_);
+  if (contacts_.skin <= 0.0) {
+    double rsum = 0.0;
+    for (double r : particles_.radius) rsum += r;
+    contacts_.skin =
+        config_.skin > 0.0 ? config_.skin : 0.1 * rsum / static_cast<double>(particles_.size());
+  }
+  if (config_.local_damping > 0.0) {
+    damp_force_.resize(particles_.size(), V::Zero());
+    damp_torque_.resize(particles_.size(), angZero<A>());
+  }
+  if (!forces_valid_) {
+    if (needsRebuild()) rebuild();
+    for (auto& f : particles_.force) f.setZero();
+    for (auto& t : particles_.torque) t = angZero<A>();
+    computeForces(0.0);
+    for (std::size_t w = 0; w < walls_.size(); ++w) wall_prev_force_[w] = walls_[w].force;
+    forces_valid_ = true;
+  }
+  if (dt_ <= 0.0) {
+    if (config_.timestep.automatic) {
+      dt_ = config_.timestep.safety * criticalTimeStep();
+      if (!std::isfinite(dt_)) {
+        throw std::invalid_argument(
+            "the automatic time step needs at least one free (not fixed) particle; set "
+            "timestep.fixed_dt for a scene of driven particles only");
+      }
+    } else {
+      requireRange(where, "timestep.fixed_dt", config_.timestep.fixed_dt, 0.0, true, INFINITY, true,
+                   "s");
+      dt_ = config_.timestep.fixed_dt;
+    }
+  }
+  if (!ledger_.started) restartEnergyLedger();
+  prepared_ = true;
+}
+
+template <int D>
+void Simulation<D>::restartEnergyLedger() {
+  ledger_ = EnergyLedger{};
+  const EnergyReport e = energy();
+  ledger_.initial = e.kinetic() + e.strain;
+  ledger_.started = true;
+  kinetic_ = e.kinetic();
+}
+
+template <int D>
+bool Simulation<D>::computeForces(double history_dt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool gravity = config_.gravity[0] != 0.0 || config_.gravity[1] != 0.0 ||
+                       (D == 3 && config_.gravity[2] != 0.0);
+  if (gravity) {
+    V g;
+    for (int d = 0; d < D; ++d) g[d] = config_.gravity[d];
+    auto& P = particles_;
+    struct Acc {
+      double work = 0.0;
+      void merge(const Acc& o) { work += o.work; }
+    };
+    const double dt = history_dt;
+    const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
+      if (P.inv_mass[i] == 0.0) return;
+      const V f = g / P.inv_mass[i];
+      P.force[i] += f;
+      a.work += f.dot(P.vel[i]) * dt;  // exact over the drift x += v dt
+    });
+    ledger_.body_work += acc.work;
+    ledger_.positive_input += std::max(acc.work, 0.0);
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  ContactPass<D> pass{particles_,
+                      contacts_,
+                      walls_,
+                      history_dt,
+                      threaded(),
+                      config_.threads,
+                      config_.track_energy,
+                      config_.guard.overlap_limit};
+  model_->computeForces(pass);
+  ledger_.friction += pass.friction;
+  ledger_.viscous += pass.viscous;
+  const auto t2 = std::chrono::steady_clock::now();
+  if (gravity) {
+    stage_seconds_[kBodyForces] += std::chrono::duration<double>(t1 - t0).count();
+    ++stage_calls_[kBodyForces];
+  }
+  stage_seconds_[kContacts] += std::chrono::duration<double>(t2 - t1).count();
+  ++stage_calls_[kContacts];
+  return pass.overlap_exceeded;
+}
+
+template <int D>
+void Simulation<D>::initialIntegrate() {
+  auto& P = particles_;
+  const double dt = dt_, h = 0.5 * dt_;
+  const bool damped = config_.local_damping > 0.0;
+  struct Acc {
+    double vmax2 = 0.0;
+    void merge(const Acc& o) { vmax2 = std::max(vmax2, o.vmax2); }
+  };
+  const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
+    V f = P.force[i];
+    A t = P.torque[i];
+    if (damped) {
+      f += damp_force_[i];
+      t += damp_torque_[i];
+    }
+    const V v = P.vel[i] + (h * P.inv_mass[i]) * f;
+    P.vel[i] = v;
+    P.spin[i] += (h * P.inv_inertia[i]) * t;
+    P.pos[i] += dt * v;
+    P.force[i].setZero();
+    P.torque[i] = angZero<A>();
+    a.vmax2 = std::max(a.vmax2, v.squaredNorm());
+  });
+  contacts_.particle_travel += std::sqrt(acc.vmax2) * dt;
+  double wall_step = 0.0;
+  for (auto& w : walls_) {
+    w.point += dt * w.velocity;
+    wall_step = std::max(wall_step, std::abs(w.velocity.dot(w.normal)) * dt);
+  }
+  contacts_.wall_travel += wall_step;
+}
+
+template <int D>
+void Simulation<D>::finalIntegrate() {
+  auto& P = particles_;
+  const double dt = dt_, h = 0.5 * dt_;
+  const double alpha = config_.local_damping;
+  const bool damped = alpha > 0.0;
+  struct Acc {
+    double ke_t = 0.0, ke_r = 0.0, damping = 0.0, driven = 0.0;
+    void merge(const Acc& o) {
+      ke_t += o.ke_t;
+      ke_r += o.ke_r;
+      damping += o.damping;
+      driven += o.driven;
+    }
+  };
+  const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
+    const double im = P.inv_mass[i], ii = P.inv_inertia[i];
+    if (im == 0.0) {
+      // A fixed particle moves with its prescribed velocity and works on its neighbours
+      // like a wall: minus the force they exert on it, times its velocity.
+      a.driven -= (P.force[i].dot(P.vel[i]) + angDot(P.torque[i], P.spin[i])) * dt;
+      return;
+    }
+    V f = P.force[i];
+    A t = P.torque[i];
+    V v = P.vel[i];
+    A w = P.spin[i];
+    V fd = V::Zero();
+    A td = angZero<A>();
+    if (damped) {
+      fd = localDamping(f, v, alpha);
+      td = localDamping(t, w, alpha);
+      damp_force_[i] = fd;
+      damp_torque_[i] = td;
+      f += fd;
+      t += td;
+    }
+    v += (h * im) * f;
+    w += (h * ii) * t;
+    P.vel[i] = v;
+    P.spin[i] = w;
+    a.ke_t += 0.5 * v.squaredNorm() / im;
+    a.ke_r += 0.5 * angDot(w, w) / ii;
+    if (damped) a.damping -= (fd.dot(v) + angDot(td, w)) * dt;
+  });
+  kinetic_ = acc.ke_t + acc.ke_r;
+  ledger_.local_damping += acc.damping;
+  ledger_.boundary_work += acc.driven;
+  ledger_.positive_input += std::max(acc.driven, 0.0);
+}
+
+template <int D>
+bool Simulation<D>::needsRebuild() {
+  auto& C = contacts_;
+  if (!C.valid || C.ref_pos.size() != particles_.size()) return true;
+  auto within = [&] {
+    const double move = C.particle_travel + C.radius_growth;
+    return 2.0 * move <= C.skin && move + C.wall_travel <= C.skin;
+  };
+  if (within()) return false;
+  // The summed per-step bound tripped: measure the true largest displacement before paying
+  // for a rebuild (oscillating particles, as in a wave, travel far less than the bound).
+  double m2 = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    m2 = std::max(m2, (particles_.pos[i] - C.ref_pos[i]).squaredNorm());
+  }
+  C.particle_travel = std::sqrt(m2);
+  return !within();
+}
+
+template <int D>
+void Simulation<D>::rebuild() {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto& P = particles_;
+  auto& C = contacts_;
+  const std::size_t n = P.size();
+
+  // Keep the old history keyed by particle slots.
+  struct Entry {
+    std::uint64_t key;
+    V shear;  // force on the pair member with the larger slot (or on the wall)
+  };
+  std::vector<Entry> old_pairs, old_walls;
+  const bool history_usable = C.valid && C.ids_at_build.size() == C.pairs.row.size() - 1;
+  if (history_usable) {
+    auto alive = [&](std::uint64_t packed) {
+      return P.valid({static_cast<std::uint32_t>(packed >> 32),
+                      static_cast<std::uint32_t>(packed & 0xffffffffu)});
+    };
+    for (std::size_t i = 0; i + 1 < C.pairs.row.size(); ++i) {
+      for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
+        if (C.shear[p].isZero()) continue;
+        const std::uint32_t j = C.pairs.col[p];
+        if (!alive(C.ids_at_build[i]) || !alive(C.ids_at_build[j])) continue;
+        const auto si = static_cast<std::uint32_t>(C.ids_at_build[i] >> 32);
+        const auto sj = static_cast<std::uint32_t>(C.ids_at_build[j] >> 32);
+        old_pairs.push_back({pairKey(si, sj), sj > si ? C.shear[p] : V(-C.shear[p])});
+      }
+    }
+    for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
+      if (C.wall_shear[c].isZero()) continue;
+      const std::uint64_t id = C.ids_at_build[C.wall_particle[c]];
+      if (!alive(id)) continue;
+      old_walls.push_back({(id >> 32) << 16 | C.wall_index[c], C.wall_shear[c]});
+    }
+  }
+  auto by_key = [](const Entry& a, const Entry& b) { return a.key < b.key; };
+  std::sort(old_pairs.begin(), old_pairs.end(), by_key);
+  std::sort(old_walls.begin(), old_walls.end(), by_key);
+  auto find = [&](const std::vector<Entry>& v, std::uint64_t key) -> const Entry* {
+    auto it = std::lower_bound(v.begin(), v.end(), Entry{key, V::Zero()}, by_key);
+    return it != v.end() && it->key == key ? &*it : nullptr;
+  };
+
+  if (config_.spatial_sort && n > 1) {
+    const auto order = NeighborGrid<D>::spatialOrder(P.pos, P.radius);
+    P.permute(order);
+    if (!damp_force_.empty()) {
+      auto apply = [&](auto& v) {
+        std::remove_reference_t<decltype(v)> out(v.size());
+        for (std::size_t k = 0; k < n; ++k) out[k] = v[order[k]];
+        v.swap(out);
+      };
+      apply(damp_force_);
+      apply(damp_torque_);
+    }
+  }
+  grid_.build(P.pos, P.radius, C.skin, C.pairs);
+
+  C.shear.assign(C.pairs.pairs(), V::Zero());
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
+      const std::uint32_t si = P.slot_of[i], sj = P.slot_of[C.pairs.col[p]];
+      if (const Entry* e = find(old_pairs, pairKey(si, sj))) {
+        C.shear[p] = sj > si ? e->shear : V(-e->shear);
+      }
+    }
+  }
+
+  C.partner_row.assign(n + 1, 0);
+  for (std::uint32_t j : C.pairs.col) ++C.partner_row[j + 1];
+  for (std::size_t i = 0; i < n; ++i) C.partner_row[i + 1] += C.partner_row[i];
+  C.partner_pair.resize(C.pairs.pairs());
+  {
+    std::vector<std::uint32_t> fill(C.partner_row.begin(), C.partner_row.end() - 1);
+    for (std::uint32_t p = 0; p < C.pairs.pairs(); ++p) C.partner_pair[fill[C.pairs.col[p]]++] = p;
+  }
+
+  C.wall_particle.clear();
+  C.wall_index.clear();
+  C.wall_shear.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      if (walls_[w].distance(P.pos[i]) < P.radius[i] + C.skin) {
+        C.wall_particle.push_back(static_cast<std::uint32_t>(i));
+        C.wall_index.push_back(static_cast<std::uint16_t>(w));
+        const Entry* e = find(old_walls, std::uint64_t{P.slot_of[i]} << 16 | w);
+        C.wall_shear.push_back(e ? e->shear : V::Zero());
+      }
+    }
+  }
+
+  C.ids_at_build.resize(n);
+  for (std::size_t i = 0; i < n; ++i) C.ids_at_build[i] = packId(P.id(i));
+  C.ref_pos = P.pos;
+  C.particle_travel = 0.0;
+  C.wall_travel = 0.0;
+  C.radius_growth = 0.0;
+  C.valid = true;
+  ++C.rebuilds;
+  stage_seconds_[kNeighbors] +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ++stage_calls_[kNeighbors];
+}
+
+template <int D>
+void Simulation<D>::step() {
+  if (contacts_.ref_pos.size() != particles_.size()) forces_valid_ = false;
+  if (!prepared_ || !forces_valid_) prepare();
+  auto t0 = std::chrono::steady_clock::now();
+  initialIntegrate();
+  auto t1 = std::chrono::steady_clock::now();
+  stage_seconds_[kIntegrate] += std::chrono::duration<double>(t1 - t0).count();
+  if (needsRebuild()) rebuild();
+
+  const bool overlap = computeForces(dt_);
+
+  t0 = std::chrono::steady_clock::now();
+  finalIntegrate();
+  t1 = std::chrono::steady_clock::now();
+  stage_seconds_[kIntegrate] += std::chrono::duration<double>(t1 - t0).count();
+  ++stage_calls_[kIntegrate];
+
+  // Work of each wall over its move this step (trapezoid in the wall force), then the
+  // servo sets the velocity of the next move.
+  for (std::size_t w = 0; w < walls_.size(); ++w) {
+    Wall<D>& wall = walls_[w];
+    const double work = -0.5 * (wall_prev_force_[w] + wall.force).dot(wall.velocity) * dt_;
+    ledger_.boundary_work += work;
+    ledger_.positive_input += std::max(work, 0.0);
+    wall_prev_force_[w] = wall.force;
+  }
+  time_ += dt_;
+  ++step_;
+  if (!walls_.empty()) {
+    for (auto& wall : walls_) wall.updateServo(time_, dt_);
+    stage_seconds_[kServo] +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    ++stage_calls_[kServo];
+  }
+
+  t0 = std::chrono::steady_clock::now();
+  guard(overlap);
+  if (config_.timestep.automatic &&
+      step_ % static_cast<std::uint64_t>(config_.timestep.update_interval) == 0) {
+    const double dt = config_.timestep.safety * criticalTimeStep();
+    if (std::isfinite(dt)) dt_ = dt;
+  }
+  stage_seconds_[kGuard] +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ++stage_calls_[kGuard];
+}
+
+template <int D>
+void Simulation<D>::run(std::uint64_t steps) {
+  for (std::uint64_t s = 0; s < steps; ++s) step();
+}
+
+template <int D>
+void Simulation<D>::guard(bool overlap_exceeded) {
+  if (!std::isfinite(kinetic_)) {
+    fail(SimulationUnstable::Cause::NonFinite, "a particle velocity is no longer finite");
+  }
+  if (overlap_exceeded) {
+    std::ostringstream s;
+    s << "an overlap exceeded " << config_.guard.overlap_limit
+      << " of the smaller radius (guard.overlap_limit)";
+    fail(SimulationUnstable::Cause::Overlap, s.str());
+  }
+  // Kinetic energy cannot exceed what the sample held plus what was put in; a few times
+  // more means the integration itself is creating energy.
+  const double budget = ledger_.initial + ledger_.positive_input;
+  if (config_.guard.energy_runaway && kinetic_ > config_.guard.energy_growth * budget &&
+      kinetic_ > 1e-300) {
+    std::ostringstream s;
+    s << "kinetic energy " << kinetic_ << " J exceeds " << config_.guard.energy_growth
+      << " times the energy put into the sample (" << budget << " J)";
+    fail(SimulationUnstable::Cause::EnergyRunaway, s.str());
+  }
+}
+
+template <int D>
+void Simulation<D>::fail(SimulationUnstable::Cause cause, const std::string& what) const {
+  std::ostringstream s;
+  s << "the run became unstable at step " << step_ << " (t = " << time_ << " s): " << what << ".\n"
+    << diagnose();
+  throw SimulationUnstable(cause, step_, s.str());
+}
+
+template <int D>
+std::string Simulation<D>::diagnose() const {
+  const auto& P = particles_;
+  std::ostringstream s;
+  s.precision(3);
+  double rmin = INFINITY;
+  for (double r : P.radius) rmin = std::min(rmin, r);
+  int causes = 0;
+
+  const double crit = criticalTimeStep();
+  if (std::isfinite(crit) && dt_ > crit) {
+    ++causes;
+    s << "Likely cause: the time step " << dt_ << " s is above the critical estimate " << crit
+      << " s (particle mass and contact stiffness); use automatic stepping or lower the "
+         "fixed step or the safety factor.\n";
+  }
+  for (const auto& w : walls_) {
+    const double per_step = w.velocity.norm() * dt_;
+    if (per_step > 0.01 * rmin) {
+      ++causes;
+      s << "Likely cause: wall '" << w.name << "' moves " << 100.0 * per_step / rmin
+        << "% of the smallest radius per step (" << w.velocity.norm()
+        << " m/s); lower its velocity or servo max_speed.\n";
+    }
+  }
+  double vmax = 0.0;
+  std::size_t fastest = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const double v = P.vel[i].norm();
+    if (!(v <= vmax)) vmax = v, fastest = i;
+  }
+  if (!std::isfinite(vmax) || vmax * dt_ > 0.05 * rmin) {
+    ++causes;
+    s << "Particle " << P.slot_of[fastest] << " at (" << P.pos[fastest].transpose() << ") moves "
+      << vmax * dt_ / rmin << " smallest radii per step.\n";
+  }
+  if (causes == 0) {
+    s << "No single cause stands out: check the stiffness contrast between materials, the "
+         "loading rate and guard.overlap_limit.\n";
+  }
+  return s.str();
+}
+
+template <int D>
+double Simulation<D>::criticalTimeStep() const {
+  const auto& P = particles_;
+  const auto& C = contacts_;
+  const std::size_t n = P.size();
+  if (!model_) throw std::logic_error("criticalTimeStep() before the simulation is prepared");
+  std::vector<double> kt(n, 0.0), kr(n, 0.0);
+  if (C.valid && C.pairs.row.size() == n + 1) {
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
+        const std::uint32_t j = C.pairs.col[p];
+        const double reach = P.radius[i] + P.radius[j];
+        const double overlap = reach - (P.pos[j] - P.pos[i]).norm();
+        if (!(overlap > 0.0)) continue;
+        const double imsum = P.inv_mass[i] + P.inv_mass[j];
+        const auto [kn, ks] =
+            model_->stiffness(P.material[i], P.material[j], overlap,
+                              P.radius[i] * P.radius[j] / reach, imsum > 0 ? 1.0 / imsum : 0.0);
+        const double li = P.radius[i] - 0.5 * overlap, lj = P.radius[j] - 0.5 * overlap;
+        kt[i] += kn, kt[j] += kn;
+        kr[i] += ks * li * li, kr[j] += ks * lj * lj;
+      }
+    }
+    for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
+      const std::uint32_t i = C.wall_particle[c];
+      const Wall<D>& w = walls_[C.wall_index[c]];
+      const double overlap = P.radius[i] - w.distance(P.pos[i]);
+      if (!(overlap > 0.0)) continue;
+      const auto [kn, ks] = model_->stiffness(P.material[i], w.material, overlap, P.radius[i],
+                                              P.inv_mass[i] > 0 ? 1.0 / P.inv_mass[i] : 0.0);
+      const double li = P.radius[i] - overlap;
+      kt[i] += kn;
+      kr[i] += ks * li * li;
+    }
+  }
+  double dt = INFINITY;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (P.inv_mass[i] == 0.0) continue;
+    const double m = 1.0 / P.inv_mass[i], inertia = 1.0 / P.inv_inertia[i];
+    dt = std::min(dt, model_->freeParticleStep(P.material[i], P.radius[i], m, inertia));
+    if (kt[i] > 0.0) dt = std::min(dt, std::sqrt(m / kt[i]));
+    if (kr[i] > 0.0) dt = std::min(dt, std::sqrt(inertia / kr[i]));
+  }
+  return dt;
+}
+
+template <int D>
+EnergyReport Simulation<D>::energy() const {
+  const auto& P = particles_;
+  const auto& C = contacts_;
+  EnergyReport e;
+  e.ledger = ledger_;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.inv_mass[i] == 0.0) continue;
+    e.kinetic_translation += 0.5 * P.vel[i].squaredNorm() / P.inv_mass[i];
+    e.kinetic_rotation += 0.5 * angDot(P.spin[i], P.spin[i]) / P.inv_inertia[i];
+  }
+  if (!model_ || !C.valid || C.pairs.row.size() != P.size() + 1) return e;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
+      const std::uint32_t j = C.pairs.col[p];
+      const double reach = P.radius[i] + P.radius[j];
+      const double overlap = reach - (P.pos[j] - P.pos[i]).norm();
+      if (!(overlap > 0.0)) continue;
+      const double imsum = P.inv_mass[i] + P.inv_mass[j];
+      e.strain += model_->strainEnergy(P.material[i], P.material[j], overlap,
+                                       P.radius[i] * P.radius[j] / reach,
+                                       imsum > 0 ? 1.0 / imsum : 0.0, C.shear[p].squaredNorm());
+    }
+  }
+  for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
+    const std::uint32_t i = C.wall_particle[c];
+    const Wall<D>& w = walls_[C.wall_index[c]];
+    const double overlap = P.radius[i] - w.distance(P.pos[i]);
+    if (!(overlap > 0.0)) continue;
+    e.strain += model_->strainEnergy(P.material[i], w.material, overlap, P.radius[i],
+                                     P.inv_mass[i] > 0 ? 1.0 / P.inv_mass[i] : 0.0,
+                                     C.wall_shear[c].squaredNorm());
+  }
+  return e;
+}
+
+template <int D>
+std::size_t Simulation<D>::particleContacts() const {
+  const auto& P = particles_;
+  const auto& C = contacts_;
+  if (!C.valid || C.pairs.row.size() != P.size() + 1) return 0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
+      const std::uint32_t j = C.pairs.col[p];
+      const double reach = P.radius[i] + P.radius[j];
+      count += (P.pos[j] - P.pos[i]).squaredNorm() < reach * reach;
+    }
+  }
+  return count;
+}
+
+template <int D>
+double Simulation<D>::maxOverlapRatio() const {
+  const auto& P = particles_;
+  const auto& C = contacts_;
+  if (!C.valid || C.pairs.row.size() != P.size() + 1) return 0.0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
+      const std::uint32_t j = C.pairs.col[p];
+      const double overlap = P.radius[i] + P.radius[j] - (P.pos[j] - P.pos[i]).norm();
+      worst = std::max(worst, overlap / std::min(P.radius[i], P.radius[j]));
+    }
+  }
+  for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
+    const std::uint32_t i = C.wall_particle[c];
+    const double overlap = P.radius[i] - walls_[C.wall_index[c]].distance(P.pos[i]);
+    worst = std::max(worst, overlap / P.radius[i]);
+  }
+  return worst;
+}
+
+template <int D>
+double Simulation<D>::coordinationNumber() const {
+  return particles_.size() ? 2.0 * static_cast<double>(particleContacts()) /
+                                 static_cast<double>(particles_.size())
+                           : 0.0;
+}
+
+template <int D>
+double Simulation<D>::unbalancedForceRatio() const {
+  const auto& P = particles_;
+  const auto& C = contacts_;
+  if (!model_ || !C.valid || C.pairs.row.size() != P.size() + 1) return 0.0;
+  double unbalanced = 0.0, contact = 0.0;
+  std::size_t free = 0, count = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.inv_mass[i] == 0.0) continue;
+    unbalanced += P.force[i].norm();
+    ++free;
+  }
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
+      const std::uint32_t j = C.pairs.col[p];
+      const double reach = P.radius[i] + P.radius[j];
+      const double overlap = reach - (P.pos[j] - P.pos[i]).norm();
+      if (!(overlap > 0.0)) continue;
+      const double fn = model_->normalForce(P.material[i], P.material[j], overlap,
+                                            P.radius[i] * P.radius[j] / reach);
+      contact += std::sqrt(fn * fn + C.shear[p].squaredNorm());
+      ++count;
+    }
+  }
+  if (count == 0 || free == 0) return 0.0;
+  return (unbalanced / static_cast<double>(free)) / (contact / static_cast<double>(count));
+}
+
+template <int D>
+std::vector<StageTiming> Simulation<D>::stageTimings() const {
+  static constexpr const char* kNames[kStages] = {"integrate", "neighbors",  "body_forces",
+                                                  "contacts",  "wall_servo", "guard"};
+  std::vector<StageTiming> out;
+  for (int s = 0; s < kStages; ++s) {
+    if (stage_calls_[s] == 0) continue;  // a stage the scene does not call for never ran
+    out.push_back({kNames[s], stage_seconds_[s], stage_calls_[s]});
+  }
+  return out;
+}
+
+template <int D>
+std::uint64_t Simulation<D>::stateHash() const {
+  const auto& P = particles_;
+  std::uint64_t h = 1469598103934665603ull;
+  h = hashVector(P.pos, h);
+  h = hashVector(P.vel, h);
+  h = hashVector(P.spin, h);
+  h = hashVector(P.force, h);
+  h = hashVector(P.torque, h);
+  h = hashVector(contacts_.shear, h);
+  h = hashVector(contacts_.wall_shear, h);
+  for (const auto& w : walls_) {
+    h = fnv1a(w.point.data(), sizeof(double) * D, h);
+    h = fnv1a(w.velocity.data(), sizeof(double) * D, h);
+    h = fnv1a(w.force.data(), sizeof(double) * D, h);
+  }
+  const double scalars[] = {time_,
+                            dt_,
+                            ledger_.boundary_work,
+                            ledger_.body_work,
+                            ledger_.friction,
+                            ledger_.viscous,
+                            ledger_.local_damping};
+  return fnv1a(scalars, sizeof scalars, h);
+}
+
+template <int D>
+template <class Archive>
+void Simulation<D>::visit(Archive& ar) {
+  ar("config.contact_law", config_.contact_law), ar("config.skin", config_.skin);
+  ar("config.local_damping", config_.local_damping);
+  ar("config.timestep.automatic", config_.timestep.automatic);
+  ar("config.timestep.fixed_dt", config_.timestep.fixed_dt);
+  ar("config.timestep.safety", config_.timestep.safety);
+  ar("config.timestep.update_interval", config_.timestep.update_interval);
+  ar("config.guard.overlap_limit", config_.guard.overlap_limit);
+  ar("config.guard.energy_growth", config_.guard.energy_growth);
+  ar("config.guard.energy_runaway", config_.guard.energy_runaway);
+  ar("config.threads", config_.threads), ar("config.track_energy", config_.track_energy);
+  ar("config.spatial_sort", config_.spatial_sort), ar("config.gravity", config_.gravity);
+
+  std::vector<Material> mats = materials_.all();
+  std::vector<OverrideRow> rows;
+  for (const auto& [k, o] : materials_.overrides()) {
+    rows.push_back({k.first, k.second, o.friction.value_or(NAN), o.damping_ratio.value_or(NAN)});
+  }
+  ar("materials", mats), ar("material_overrides", rows);
+  if constexpr (Archive::kReading) {
+    materials_ = MaterialTable{};
+    for (auto& m : mats) materials_.add(std::move(m));
+    for (const auto& r : rows) {
+      PairOverride o;
+      if (!std::isnan(r.friction)) o.friction = r.friction;
+      if (!std::isnan(r.damping_ratio)) o.damping_ratio = r.damping_ratio;
+      materials_.setPair(r.a, r.b, o);
+    }
+  }
+
+  particles_.visit(ar);
+  ar("walls", walls_), ar("wall_prev_force", wall_prev_force_);
+  contacts_.visit(ar);
+  rng_.visit(ar);
+  ar("ledger.initial", ledger_.initial), ar("ledger.boundary_work", ledger_.boundary_work);
+  ar("ledger.body_work", ledger_.body_work), ar("ledger.friction", ledger_.friction);
+  ar("ledger.viscous", ledger_.viscous), ar("ledger.local_damping", ledger_.local_damping);
+  ar("ledger.positive_input", ledger_.positive_input), ar("ledger.started", ledger_.started);
+  ar("time", time_), ar("dt", dt_), ar("step", step_), ar("kinetic", kinetic_);
+  ar("forces_valid", forces_valid_);
+  ar("damp_force", damp_force_), ar("damp_torque", damp_torque_);
+}
+
+template <int D>
+void Simulation<D>::saveCheckpoint(const std::string& path) const {
+  ArchiveWriter w;
+  const_cast<Simulation*>(this)->visit(w);
+  std::string file(kMagic, sizeof kMagic);
+  const std::uint32_t version = kCheckpointVersion, dim = D;
+  file.append(reinterpret_cast<const char*>(&version), sizeof version);
+  file.append(reinterpret_cast<const char*>(&dim), sizeof dim);
+  file += w.bytes();
+  const std::uint64_t sum = fnv1a(file.data(), file.size());
+  file.append(reinterpret_cast<const char*>(&sum), sizeof sum);
+  file.append(kTrailer, sizeof kTrailer);
+  // Write beside the target and rename: a crash never leaves a half-written checkpoint.
+  const std::string tmp = path + ".partial";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw CheckpointError("cannot write checkpoint '" + tmp + "'");
+    out.write(file.data(), static_cast<std::streamsize>(file.size()));
+    if (!out) throw CheckpointError("writing checkpoint '" + tmp + "' failed");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+template <int D>
+Simulation<D> Simulation<D>::loadCheckpoint(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CheckpointError("cannot open checkpoint '" + path + "'");
+  const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t head = sizeof kMagic + 8, tail = 8 + sizeof kTrailer;
+  if (file.size() < sizeof kMagic || std::memcmp(file.data(), kMagic, sizeof kMagic) != 0) {
+    throw CheckpointError("'" + path + "' is not a rocklab checkpoint");
+  }
+  if (file.size() < head + tail ||
+      std::memcmp(file.data() + file.size() - sizeof kTrailer, kTrailer, sizeof kTrailer) != 0) {
+    throw CheckpointError("checkpoint '" + path + "' is truncated (its end marker is missing)");
+  }
+  std::uint32_t version, dim;
+  std::memcpy(&version, file.data() + sizeof kMagic, 4);
+  std::memcpy(&dim, file.data() + sizeof kMagic + 4, 4);
+  if (version != kCheckpointVersion) {
+    throw CheckpointError("checkpoint '" + path + "' has format version " +
+                          std::to_string(version) + "; this rocklab reads version " +
+                          std::to_string(kCheckpointVersion) +
+                          " only: resume it with the rocklab that wrote it");
+  }
+  if (dim != D) {
+    throw CheckpointError("checkpoint '" + path + "' holds a " + std::to_string(dim) +
+                          "D scene, not " + std::to_string(D) + "D");
+  }
+  std::uint64_t sum;
+  std::memcpy(&sum, file.data() + file.size() - tail, sizeof sum);
+  if (fnv1a(file.data(), file.size() - tail) != sum) {
+    throw CheckpointError("checkpoint '" + path + "' is damaged (checksum mismatch)");
+  }
+  Simulation sim(MaterialTable{}, SimulationConfig{});
+  ArchiveReader r(file.data() + head, file.size() - head - tail);
+  sim.visit(r);
+  if (!r.atEnd()) throw CheckpointError("checkpoint '" + path + "' has trailing data");
+  return sim;
+}
+
+template class Simulation<2>;
+template class Simulation<3>;
+
+}  // namespace rocklab

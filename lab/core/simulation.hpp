@@ -1,0 +1,207 @@
+#pragma once
+// A DEM simulation: particles, walls and contacts advanced by velocity Verlet, with only
+// the stages the scene calls for, per-stage timing, energy bookkeeping, an instability
+// guard and checkpoints.
+//
+// Who may change what: scene set-up code (generators, rigs between steps) edits particles
+// and walls through the mutable accessors; rigs during a run only set wall velocities and
+// servo targets; observers (logging, rendering) use the const accessors and can never
+// change the run.
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "lab/core/contact_model.hpp"
+#include "lab/core/contacts.hpp"
+#include "lab/core/material.hpp"
+#include "lab/core/neighbors.hpp"
+#include "lab/core/particles.hpp"
+#include "lab/core/random.hpp"
+#include "lab/core/walls.hpp"
+
+namespace rocklab {
+
+struct TimeStepConfig {
+  bool automatic = true;      // estimate the critical step and follow it
+  double fixed_dt = 0.0;      // s, the step when not automatic
+  double safety = 0.5;        // -, automatic step = safety * critical estimate
+  int update_interval = 100;  // steps between critical-step estimates
+};
+
+struct GuardConfig {
+  double overlap_limit = 0.25;  // -, largest overlap / smaller radius before the run stops
+  double energy_growth = 2.0;   // -, kinetic energy above this times (initial + input) stops it
+  // Off only for scenes that add energy no ledger sees (radius expansion in packing).
+  bool energy_runaway = true;
+};
+
+struct SimulationConfig {
+  std::string contact_law = "linear";
+  double skin = 0.0;           // m, Verlet skin; 0 picks 0.1 x the mean radius
+  double local_damping = 0.0;  // -, PFC local damping coefficient, 0 (off) to < 1
+  TimeStepConfig timestep;
+  GuardConfig guard;
+  int threads = 1;           // OpenMP threads; results do not depend on it
+  bool track_energy = true;  // friction and viscous dissipation, per contact
+  bool spatial_sort = true;  // reorder particles along the cell grid on rebuilds
+  std::array<double, 3> gravity{0.0, 0.0, 0.0};  // m/s^2, only the first D components used
+};
+
+// Energy exchanged since the ledger started (J).
+struct EnergyLedger {
+  double initial = 0.0;         // kinetic + strain energy when the ledger started
+  double boundary_work = 0.0;   // work of walls and driven (fixed) particles on the others
+  double body_work = 0.0;       // work of gravity
+  double friction = 0.0;        // dissipated by Coulomb sliding
+  double viscous = 0.0;         // dissipated by contact dashpots
+  double local_damping = 0.0;   // dissipated by local (non-viscous) damping
+  double positive_input = 0.0;  // energy put in (for the runaway guard)
+  bool started = false;
+};
+
+struct EnergyReport {
+  double kinetic_translation = 0.0;
+  double kinetic_rotation = 0.0;
+  double strain = 0.0;
+  EnergyLedger ledger;
+  double kinetic() const { return kinetic_translation + kinetic_rotation; }
+  // Energy now held or dissipated, minus the energy that came in: zero for an exact scheme.
+  double imbalance() const {
+    return kinetic() + strain + ledger.friction + ledger.viscous + ledger.local_damping -
+           (ledger.initial + ledger.boundary_work + ledger.body_work);
+  }
+};
+
+class SimulationUnstable : public std::runtime_error {
+ public:
+  enum class Cause { NonFinite, Overlap, EnergyRunaway };
+  SimulationUnstable(Cause cause, std::uint64_t step, const std::string& diagnosis)
+      : std::runtime_error(diagnosis), cause_(cause), step_(step) {}
+  Cause cause() const { return cause_; }
+  std::uint64_t step() const { return step_; }
+
+ private:
+  Cause cause_;
+  std::uint64_t step_;
+};
+
+struct StageTiming {
+  std::string name;
+  double seconds = 0.0;
+  std::uint64_t calls = 0;
+};
+
+template <int D>
+class Simulation {
+ public:
+  using V = Vec<D>;
+  using A = Ang<D>;
+
+  Simulation(MaterialTable materials, SimulationConfig config);
+  ~Simulation();
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+
+  // --- scene set-up ---
+  ParticleStore<D>& particles() { return particles_; }
+  const ParticleStore<D>& particles() const { return particles_; }
+  std::size_t addWall(Wall<D> w);
+  Wall<D>& wall(std::size_t i) { return walls_.at(i); }
+  const Wall<D>& wall(std::size_t i) const { return walls_.at(i); }
+  const std::vector<Wall<D>>& walls() const { return walls_; }
+  const MaterialTable& materials() const { return materials_; }
+  const SimulationConfig& config() const { return config_; }
+  // Call after moving particles by hand, adding or removing them, or changing radii.
+  void invalidateNeighbors() {
+    contacts_.valid = false;
+    forces_valid_ = false;
+  }
+  // Scales every radius by `factor` (radius expansion); masses stay. Growth counts against
+  // the neighbour skin like motion, so the list is rebuilt only when needed.
+  void scaleRadii(double factor);
+  void setThreads(int threads);
+  void setLocalDamping(double alpha) { config_.local_damping = alpha; }
+  void setFixedTimeStep(double dt);
+  // Starts the energy ledger anew from the present state.
+  void restartEnergyLedger();
+  Rng& rng() { return rng_; }
+
+  // --- running ---
+  void step();
+  void run(std::uint64_t steps);
+
+  // --- const read-outs ---
+  double time() const { return time_; }
+  double dt() const { return dt_; }
+  std::uint64_t steps() const { return step_; }
+  // The critical time step estimate (s): min over particles of sqrt(m / sum kn) and
+  // sqrt(I / sum ks l^2) with tangent stiffnesses, and of the lone-particle bound.
+  double criticalTimeStep() const;
+  EnergyReport energy() const;
+  // Mean particle-particle contacts per particle, 2 C / N (overlap > 0; walls excluded).
+  double coordinationNumber() const;
+  std::size_t particleContacts() const;
+  // Largest overlap over the smaller radius, particle pairs and walls.
+  double maxOverlapRatio() const;
+  // Mean unbalanced force over mean contact force (PFC's equilibrium measure).
+  double unbalancedForceRatio() const;
+  const ContactStore<D>& contacts() const { return contacts_; }
+  std::vector<StageTiming> stageTimings() const;
+  // FNV-1a hash of the dynamic state, to compare runs bit for bit.
+  std::uint64_t stateHash() const;
+
+  // --- checkpoints ---
+  void saveCheckpoint(const std::string& path) const;
+  static Simulation loadCheckpoint(const std::string& path);
+  static constexpr std::uint32_t kCheckpointVersion = 1;
+
+ private:
+  enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kServo, kGuard, kStages };
+
+  void prepare();
+  // Forces and torques at the present positions. With history_dt = 0 the contact history
+  // does not advance (the set-up evaluation that velocity Verlet needs before its first
+  // step); returns whether an overlap exceeded the guard's limit.
+  bool computeForces(double history_dt);
+  void initialIntegrate();
+  void finalIntegrate();
+  bool needsRebuild();
+  void rebuild();
+  void guard(bool overlap_exceeded);
+  [[noreturn]] void fail(SimulationUnstable::Cause cause, const std::string& what) const;
+  std::string diagnose() const;
+  template <class Archive>
+  void visit(Archive& ar);
+  bool threaded() const { return config_.threads > 1; }
+
+  MaterialTable materials_;
+  SimulationConfig config_;
+  ParticleStore<D> particles_;
+  std::vector<Wall<D>> walls_;
+  std::vector<V> wall_prev_force_;
+  ContactStore<D> contacts_;
+  NeighborGrid<D> grid_;
+  std::unique_ptr<ContactModel<D>> model_;
+  Rng rng_;
+  EnergyLedger ledger_;
+
+  double time_ = 0.0;
+  double dt_ = 0.0;
+  std::uint64_t step_ = 0;
+  double kinetic_ = 0.0;  // after the last step, for the guard
+  bool prepared_ = false;
+  bool forces_valid_ = false;
+  // Local damping force and torque of the last step, kept apart so that `force` and
+  // `torque` stay the physical unbalanced force; allocated only when damping is on.
+  std::vector<V> damp_force_;
+  std::vector<A> damp_torque_;
+  std::array<double, kStages> stage_seconds_{};
+  std::array<std::uint64_t, kStages> stage_calls_{};
+};
+
+}  // namespace rocklab

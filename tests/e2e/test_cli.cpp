@@ -1,0 +1,102 @@
+// The rocklab command end to end: version, bench (thread-count determinism), pack, errors.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <regex>
+#include <string>
+
+#include "lab/core/packing_io.hpp"
+
+namespace {
+
+struct Result {
+  int status;
+  std::string out;
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(ROCKLAB_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pclose(pipe);
+  return {WEXITSTATUS(status), out};
+}
+
+std::string tempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("rocklab-" + std::to_string(::getpid()) + "-" + name))
+      .string();
+}
+
+TEST(Cli, VersionNamesRevisionAndBuildType) {
+  const auto r = run("version");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("rocklab [0-9.]+ \\(git [0-9a-f]+|unknown")))
+      << r.out;
+  EXPECT_NE(r.out.find("build"), std::string::npos) << r.out;
+}
+
+TEST(Cli, HelpListsCommands) {
+  const auto r = run("--help");
+  EXPECT_EQ(r.status, 0);
+  for (const char* c : {"bench", "pack", "version", "laws"}) {
+    EXPECT_NE(r.out.find(c), std::string::npos) << c;
+  }
+}
+
+TEST(Cli, BenchGivesTheSameStateOnOneAndTwoThreads) {
+  const auto packing = tempPath("bench.txt");
+  const auto r =
+      run("bench --n 600 --steps 60 --warmup 10 --threads 1,2 --json --save-packing " + packing);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::regex hash("\"state_hash\": \"([0-9a-f]+)\"");
+  std::vector<std::string> hashes;
+  for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), hash);
+       it != std::sregex_iterator(); ++it) {
+    hashes.push_back((*it)[1]);
+  }
+  ASSERT_EQ(hashes.size(), 2u) << r.out;
+  EXPECT_EQ(hashes[0], hashes[1]);
+  EXPECT_NE(r.out.find("\"particle_steps_per_second\""), std::string::npos);
+  // The saved packing runs again from the file and gives the same state.
+  const auto again = run("bench --packing " + packing + " --steps 60 --warmup 10 --json");
+  ASSERT_EQ(again.status, 0) << again.out;
+  EXPECT_NE(again.out.find(hashes[0]), std::string::npos) << again.out;
+  std::filesystem::remove(packing);
+}
+
+TEST(Cli, PackWritesAReadablePacking) {
+  const auto out = tempPath("pack2d.txt");
+  const auto r =
+      run("pack --dim 2 --n 300 --dist phi --phi-mean -1 --phi-std 0.3 --d-min-mm 0.5 "
+          "--d-max-mm 5 --porosity 0.25 --out " +
+          out);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(rocklab::packingFileDimension(out), 2);
+  const auto p = rocklab::readPacking<2>(out);
+  EXPECT_EQ(p.centers.size(), 300u);
+  EXPECT_NEAR(p.porosity(), 0.25, 1e-6);
+  std::filesystem::remove(out);
+}
+
+TEST(Cli, BadInputIsRefusedClearly) {
+  auto r = run("bench --packing /nonexistent/file.txt");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("/nonexistent/file.txt"), std::string::npos) << r.out;
+  r = run("pack --porosity 2 --out /tmp/x.txt");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("porosity"), std::string::npos) << r.out;
+  r = run("pack --dist normal --d-mean-mm 9 --d-min-mm 1 --d-max-mm 2 --out /tmp/x.txt");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("d_mean"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(m)"), std::string::npos) << r.out;
+  r = run("frobnicate");
+  EXPECT_NE(r.status, 0);
+}
+
+}  // namespace

@@ -1,0 +1,61 @@
+// Same scene and seed give the same bits whatever the thread count (Box2D's determinism
+// test, DESIGN.md rule 8).
+
+#include <gtest/gtest.h>
+
+#include <omp.h>
+
+#include "lab/core/packing.hpp"
+#include "tests/support.hpp"
+
+namespace rocklab {
+namespace {
+
+using V3 = Eigen::Vector3d;
+
+TEST(Determinism, PackingIsTheSameOnOneAndTwoThreads) {
+  PackingSpec spec;
+  spec.count = 3000;
+  spec.sizes = SizeDistribution::phiGaussian(-1.0, 0.4, 0.5e-3, 6e-3);
+  spec.porosity = 0.4;
+  spec.seed = 17;
+  spec.threads = 1;
+  const auto one = generatePacking<3>(spec);
+  spec.threads = 2;
+  const auto two = generatePacking<3>(spec);
+  ASSERT_EQ(one.centers.size(), two.centers.size());
+  for (std::size_t i = 0; i < one.centers.size(); ++i) {
+    ASSERT_EQ(one.centers[i], two.centers[i]) << "particle " << i;
+  }
+}
+
+std::uint64_t compressedHash(int threads, int dim_steps) {
+  PackingSpec spec;
+  spec.count = 2500;
+  spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
+  spec.porosity = 0.42;
+  spec.seed = 4;
+  const auto p = generatePacking<3>(spec);
+  SimulationConfig cfg;
+  cfg.contact_law = "hertz";
+  cfg.local_damping = 0.2;
+  cfg.threads = threads;
+  cfg.gravity = {0, 0, -9.81};
+  Simulation<3> sim(testing::table(testing::hertzMaterial(5e8, 0.25, 0.5, 0.1)), cfg);
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    testing::addParticle<3>(sim, p.centers[i], p.radii[i], V3::Zero());
+  }
+  testing::addBox<3>(sim, p.lo, p.hi);
+  for (int w = 0; w < 6; ++w) sim.wall(w).velocity = 0.05 * sim.wall(w).normal;
+  sim.run(dim_steps);
+  EXPECT_GT(sim.contacts().rebuilds, 1u);
+  return sim.stateHash();
+}
+
+TEST(Determinism, CompressionIsTheSameOnOneAndTwoThreads) {
+  ASSERT_GE(omp_get_num_procs(), 1);
+  EXPECT_EQ(compressedHash(1, 3000), compressedHash(2, 3000));
+}
+
+}  // namespace
+}  // namespace rocklab
