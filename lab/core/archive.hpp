@@ -53,7 +53,10 @@ class ArchiveWriter {
   const std::string& bytes() const { return bytes_; }
 
  private:
-  void raw(const void* p, std::size_t n) { bytes_.append(static_cast<const char*>(p), n); }
+  void raw(const void* p, std::size_t n) {
+    if (n > 0)
+      bytes_.append(static_cast<const char*>(p), n);  // an empty vector's data() may be null
+  }
   void putString(std::string_view s) {
     const auto n = static_cast<std::uint64_t>(s.size());
     raw(&n, sizeof n);
@@ -111,6 +114,7 @@ class ArchiveReader {
 
  private:
   void raw(void* out, std::size_t n) {
+    if (n == 0) return;  // an empty vector's data() may be null
     if (static_cast<std::size_t>(end_ - p_) < n) {
       throw CheckpointError("checkpoint ends early: the file is truncated");
     }
