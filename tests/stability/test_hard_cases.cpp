@@ -155,6 +155,37 @@ TEST(HardCases, WallTooFastIsDiagnosed) {
   }
 }
 
+// Hertz contacts stiffen as they load: the automatic step must shrink with them.
+TEST(HardCases, AutomaticStepFollowsHertzStiffening) {
+  Simulation<3> sim = densePack(0.5);
+  SimulationConfig cfg = sim.config();
+  ASSERT_FALSE(cfg.timestep.automatic);  // densePack fixed it; rebuild the scene automatic
+  PackingSpec spec;
+  spec.count = 800;
+  spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
+  spec.porosity = 0.45;
+  const Packing<3> p = generatePacking<3>(spec);
+  cfg.timestep.automatic = true;
+  cfg.local_damping = 0.5;
+  Simulation<3> auto_sim(testing::table(testing::hertzMaterial(1e9, 0.25, 0.5)), cfg);
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    testing::addParticle<3>(auto_sim, p.centers[i], p.radii[i], V3::Zero());
+  }
+  testing::addBox<3>(auto_sim, p.lo, p.hi);
+  for (int w = 0; w < 6; ++w) auto_sim.wall(w).velocity = 0.05 * auto_sim.wall(w).normal;
+  auto_sim.step();
+  const double dt_loose = auto_sim.dt();
+  double smallest_ratio = INFINITY;
+  for (int k = 0; k < 60; ++k) {
+    auto_sim.run(100);
+    smallest_ratio = std::min(smallest_ratio, auto_sim.criticalTimeStep() / auto_sim.dt());
+  }
+  EXPECT_GT(auto_sim.maxOverlapRatio(), 0.01);  // really squeezed
+  EXPECT_LT(auto_sim.dt(), 0.8 * dt_loose);
+  // Between two estimates the stiffness grows a little: the step stays below critical.
+  EXPECT_GT(smallest_ratio, 1.0);
+}
+
 TEST(HardCases, OneParticleAndEmptyScenes) {
   Simulation<3> one(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), SimulationConfig{});
   testing::addParticle<3>(one, V3::Zero(), 1e-3, V3(0.1, 0, 0));

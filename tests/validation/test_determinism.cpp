@@ -57,5 +57,28 @@ TEST(Determinism, CompressionIsTheSameOnOneAndTwoThreads) {
   EXPECT_EQ(compressedHash(1, 3000), compressedHash(2, 3000));
 }
 
+TEST(Determinism, DisksAreTheSameOnOneAndTwoThreads) {
+  auto hash = [](int threads) {
+    PackingSpec spec;
+    spec.count = 4000;
+    spec.sizes = SizeDistribution::normal(2e-3, 0.4e-3, 1e-3, 3e-3);
+    spec.porosity = 0.2;
+    spec.threads = threads;
+    const auto p = generatePacking<2>(spec);
+    SimulationConfig cfg;
+    cfg.local_damping = 0.1;
+    cfg.threads = threads;
+    Simulation<2> sim(testing::table(testing::linearMaterial(1e7, 5e6, 0.5, 0.1)), cfg);
+    for (std::size_t i = 0; i < p.centers.size(); ++i) {
+      testing::addParticle<2>(sim, p.centers[i], p.radii[i], Eigen::Vector2d::Zero());
+    }
+    testing::addBox<2>(sim, p.lo, p.hi);
+    for (int w = 0; w < 4; ++w) sim.wall(w).velocity = 0.05 * sim.wall(w).normal;
+    sim.run(3000);
+    return sim.stateHash();
+  };
+  EXPECT_EQ(hash(1), hash(2));
+}
+
 }  // namespace
 }  // namespace rocklab
