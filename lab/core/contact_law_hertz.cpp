@@ -15,7 +15,6 @@ void validate(const MaterialTable& m) {
     requireRange(where, "poisson", a.poisson, -1.0, true, 0.5, false, "-");
     requireRange(where, "friction", a.friction, 0.0, false, INFINITY, true, "-");
     requireRange(where, "damping_ratio", a.damping_ratio, 0.0, false, 1.0, true, "-");
-    requireRange(where, "density", a.density, 0.0, true, INFINITY, true, "kg/m^3");
   }
 }
 
@@ -45,7 +44,7 @@ const ContactLawEntry kHertzLawEntry{
     "hertz",
     "Hertz normal force, Mindlin no-slip tangential stiffness, Coulomb friction, Tsuji "
     "dashpots by damping ratio (2D disks use the sphere formula, as PFC2D does)",
-    "young (Pa), poisson (-), friction (-), damping_ratio (-), density (kg/m^3)",
+    "young (Pa), poisson (-), friction (-), damping_ratio (-)",
     validate,
     make<2>,
     make<3>,

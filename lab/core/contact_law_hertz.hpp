@@ -38,9 +38,10 @@ struct HertzLaw {
   }
   // Rayleigh wave time across the particle, T_R = pi r sqrt(rho/G) / (0.1631 nu + 0.8766)
   // (Li, Xu & Thornton 2005): the usual bound before contact stiffness is known.
-  static double freeParticleStep(const Params&, const Material& m, double radius, double, double) {
+  static double freeParticleStep(const Params&, const Material& m, double radius, double, double,
+                                 double density) {
     const double g = m.young / (2.0 * (1.0 + m.poisson));
-    return std::numbers::pi * radius * std::sqrt(m.density / g) / (0.1631 * m.poisson + 0.8766);
+    return std::numbers::pi * radius * std::sqrt(density / g) / (0.1631 * m.poisson + 0.8766);
   }
 };
 

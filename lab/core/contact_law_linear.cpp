@@ -15,7 +15,6 @@ void validate(const MaterialTable& m) {
     requireRange(where, "ks", a.ks, 0.0, false, INFINITY, true, "N/m");
     requireRange(where, "friction", a.friction, 0.0, false, INFINITY, true, "-");
     requireRange(where, "damping_ratio", a.damping_ratio, 0.0, false, 1.0, true, "-");
-    requireRange(where, "density", a.density, 0.0, true, INFINITY, true, "kg/m^3");
   }
 }
 
@@ -45,7 +44,7 @@ const ContactLawEntry kLinearLawEntry{
     "linear",
     "linear normal and shear springs in series per contact, Coulomb friction, dashpots by "
     "critical damping ratio",
-    "kn (N/m), ks (N/m), friction (-), damping_ratio (-), density (kg/m^3)",
+    "kn (N/m), ks (N/m), friction (-), damping_ratio (-)",
     validate,
     make<2>,
     make<3>,

@@ -35,7 +35,7 @@ struct LinearLaw {
   // Critical step of a lone particle against one contact of its own kind: sqrt(m/kn) for
   // translation, sqrt(I/(ks r^2)) for rotation (Itasca 1999, PFC time step).
   static double freeParticleStep(const Params& self, const Material&, double radius, double mass,
-                                 double inertia) {
+                                 double inertia, double /*density*/) {
     double dt = std::sqrt(mass / self.kn);
     if (self.ks > 0.0) dt = std::min(dt, std::sqrt(inertia / (self.ks * radius * radius)));
     return dt;

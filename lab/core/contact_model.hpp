@@ -68,7 +68,7 @@ class ContactModel {
   // contacts form (linear: sqrt(m / kn) of a contact with its own kind; Hertz: the Rayleigh
   // wave time across the particle).
   virtual double freeParticleStep(std::uint16_t material, double radius, double mass,
-                                  double inertia) const = 0;
+                                  double inertia, double density) const = 0;
 };
 
 // Pair parameters of every material pair, mixed once.

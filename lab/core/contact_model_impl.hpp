@@ -48,10 +48,10 @@ class ContactModelImpl final : public ContactModel<D> {
     return contactStrainEnergy<Law>(table_(mi, mj), overlap, rstar, shear_force2, mstar);
   }
 
-  double freeParticleStep(std::uint16_t material, double radius, double mass,
-                          double inertia) const override {
+  double freeParticleStep(std::uint16_t material, double radius, double mass, double inertia,
+                          double density) const override {
     return Law::freeParticleStep(table_(material, material), materials_[material], radius, mass,
-                                 inertia);
+                                 inertia, density);
   }
 
  private:

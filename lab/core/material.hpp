@@ -15,7 +15,7 @@ namespace rocklab {
 // contact_laws.hpp) and validates them before a run starts.
 struct Material {
   std::string name = "default";
-  double density = 2650.0;     // kg/m^3
+  double density = 2650.0;     // kg/m^3, for scene builders: particles carry their own
   double young = 70e9;         // Pa, Hertz-Mindlin
   double poisson = 0.25;       // -, Hertz-Mindlin
   double kn = 0.0;             // N/m, linear: the particle's normal spring, in series per contact

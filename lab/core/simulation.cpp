@@ -632,7 +632,8 @@ double Simulation<D>::criticalTimeStep() const {
   for (std::size_t i = 0; i < n; ++i) {
     if (P.inv_mass[i] == 0.0) continue;
     const double m = 1.0 / P.inv_mass[i], inertia = 1.0 / P.inv_inertia[i];
-    dt = std::min(dt, model_->freeParticleStep(P.material[i], P.radius[i], m, inertia));
+    dt = std::min(
+        dt, model_->freeParticleStep(P.material[i], P.radius[i], m, inertia, m / P.volume(i)));
     if (kt[i] > 0.0) dt = std::min(dt, std::sqrt(m / kt[i]));
     if (kr[i] > 0.0) dt = std::min(dt, std::sqrt(inertia / kr[i]));
   }
