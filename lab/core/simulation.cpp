@@ -594,40 +594,60 @@ std::string Simulation<D>::diagnose() const {
 }
 
 template <int D>
-double Simulation<D>::criticalTimeStep() const {
+template <class F>
+void Simulation<D>::forEachTouching(F&& visit) const {
   const auto& P = particles_;
   const auto& C = contacts_;
+  if (!C.valid || C.pairs.row.size() != P.size() + 1) return;
+  Touching t;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
+      const std::uint32_t j = C.pairs.col[p];
+      const double reach = P.radius[i] + P.radius[j];
+      t.overlap = reach - (P.pos[j] - P.pos[i]).norm();
+      if (!(t.overlap > 0.0)) continue;
+      const double imsum = P.inv_mass[i] + P.inv_mass[j];
+      t.i = i, t.j = j, t.wall = nullptr;
+      t.mi = P.material[i], t.mj = P.material[j];
+      t.rstar = P.radius[i] * P.radius[j] / reach;
+      t.mstar = imsum > 0.0 ? 1.0 / imsum : 0.0;
+      t.li = P.radius[i] - 0.5 * t.overlap, t.lj = P.radius[j] - 0.5 * t.overlap;
+      t.min_radius = std::min(P.radius[i], P.radius[j]);
+      t.shear2 = C.shear[p].squaredNorm();
+      visit(t);
+    }
+  }
+  for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
+    const std::uint32_t i = C.wall_particle[c];
+    const Wall<D>& w = walls_[C.wall_index[c]];
+    t.overlap = P.radius[i] - w.distance(P.pos[i]);
+    if (!(t.overlap > 0.0)) continue;
+    t.i = i, t.j = i, t.wall = &w;
+    t.mi = P.material[i], t.mj = w.material;
+    t.rstar = P.radius[i];
+    t.mstar = P.inv_mass[i] > 0.0 ? 1.0 / P.inv_mass[i] : 0.0;
+    t.li = P.radius[i] - t.overlap, t.lj = 0.0;
+    t.min_radius = P.radius[i];
+    t.shear2 = C.wall_shear[c].squaredNorm();
+    visit(t);
+  }
+}
+
+template <int D>
+double Simulation<D>::criticalTimeStep() const {
+  const auto& P = particles_;
   const std::size_t n = P.size();
   if (!model_) throw std::logic_error("criticalTimeStep() before the simulation is prepared");
   std::vector<double> kt(n, 0.0), kr(n, 0.0);
-  if (C.valid && C.pairs.row.size() == n + 1) {
-    for (std::size_t i = 0; i < n; ++i) {
-      for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
-        const std::uint32_t j = C.pairs.col[p];
-        const double reach = P.radius[i] + P.radius[j];
-        const double overlap = reach - (P.pos[j] - P.pos[i]).norm();
-        if (!(overlap > 0.0)) continue;
-        const double imsum = P.inv_mass[i] + P.inv_mass[j];
-        const auto [kn, ks] =
-            model_->stiffness(P.material[i], P.material[j], overlap,
-                              P.radius[i] * P.radius[j] / reach, imsum > 0 ? 1.0 / imsum : 0.0);
-        const double li = P.radius[i] - 0.5 * overlap, lj = P.radius[j] - 0.5 * overlap;
-        kt[i] += kn, kt[j] += kn;
-        kr[i] += ks * li * li, kr[j] += ks * lj * lj;
-      }
+  forEachTouching([&](const Touching& t) {
+    const auto [kn, ks] = model_->stiffness(t.mi, t.mj, t.overlap, t.rstar, t.mstar);
+    kt[t.i] += kn;
+    kr[t.i] += ks * t.li * t.li;
+    if (!t.wall) {
+      kt[t.j] += kn;
+      kr[t.j] += ks * t.lj * t.lj;
     }
-    for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
-      const std::uint32_t i = C.wall_particle[c];
-      const Wall<D>& w = walls_[C.wall_index[c]];
-      const double overlap = P.radius[i] - w.distance(P.pos[i]);
-      if (!(overlap > 0.0)) continue;
-      const auto [kn, ks] = model_->stiffness(P.material[i], w.material, overlap, P.radius[i],
-                                              P.inv_mass[i] > 0 ? 1.0 / P.inv_mass[i] : 0.0);
-      const double li = P.radius[i] - overlap;
-      kt[i] += kn;
-      kr[i] += ks * li * li;
-    }
-  }
+  });
   double dt = INFINITY;
   for (std::size_t i = 0; i < n; ++i) {
     if (P.inv_mass[i] == 0.0) continue;
@@ -643,7 +663,6 @@ double Simulation<D>::criticalTimeStep() const {
 template <int D>
 EnergyReport Simulation<D>::energy() const {
   const auto& P = particles_;
-  const auto& C = contacts_;
   EnergyReport e;
   e.ledger = ledger_;
   for (std::size_t i = 0; i < P.size(); ++i) {
@@ -651,65 +670,24 @@ EnergyReport Simulation<D>::energy() const {
     e.kinetic_translation += 0.5 * P.vel[i].squaredNorm() / P.inv_mass[i];
     e.kinetic_rotation += 0.5 * angDot(P.spin[i], P.spin[i]) / P.inv_inertia[i];
   }
-  if (!model_ || !C.valid || C.pairs.row.size() != P.size() + 1) return e;
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
-      const std::uint32_t j = C.pairs.col[p];
-      const double reach = P.radius[i] + P.radius[j];
-      const double overlap = reach - (P.pos[j] - P.pos[i]).norm();
-      if (!(overlap > 0.0)) continue;
-      const double imsum = P.inv_mass[i] + P.inv_mass[j];
-      e.strain += model_->strainEnergy(P.material[i], P.material[j], overlap,
-                                       P.radius[i] * P.radius[j] / reach,
-                                       imsum > 0 ? 1.0 / imsum : 0.0, C.shear[p].squaredNorm());
-    }
-  }
-  for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
-    const std::uint32_t i = C.wall_particle[c];
-    const Wall<D>& w = walls_[C.wall_index[c]];
-    const double overlap = P.radius[i] - w.distance(P.pos[i]);
-    if (!(overlap > 0.0)) continue;
-    e.strain += model_->strainEnergy(P.material[i], w.material, overlap, P.radius[i],
-                                     P.inv_mass[i] > 0 ? 1.0 / P.inv_mass[i] : 0.0,
-                                     C.wall_shear[c].squaredNorm());
-  }
+  if (!model_) return e;
+  forEachTouching([&](const Touching& t) {
+    e.strain += model_->strainEnergy(t.mi, t.mj, t.overlap, t.rstar, t.mstar, t.shear2);
+  });
   return e;
 }
 
 template <int D>
 std::size_t Simulation<D>::particleContacts() const {
-  const auto& P = particles_;
-  const auto& C = contacts_;
-  if (!C.valid || C.pairs.row.size() != P.size() + 1) return 0;
   std::size_t count = 0;
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
-      const std::uint32_t j = C.pairs.col[p];
-      const double reach = P.radius[i] + P.radius[j];
-      count += (P.pos[j] - P.pos[i]).squaredNorm() < reach * reach;
-    }
-  }
+  forEachTouching([&](const Touching& t) { count += t.wall == nullptr; });
   return count;
 }
 
 template <int D>
 double Simulation<D>::maxOverlapRatio() const {
-  const auto& P = particles_;
-  const auto& C = contacts_;
-  if (!C.valid || C.pairs.row.size() != P.size() + 1) return 0.0;
   double worst = 0.0;
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
-      const std::uint32_t j = C.pairs.col[p];
-      const double overlap = P.radius[i] + P.radius[j] - (P.pos[j] - P.pos[i]).norm();
-      worst = std::max(worst, overlap / std::min(P.radius[i], P.radius[j]));
-    }
-  }
-  for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
-    const std::uint32_t i = C.wall_particle[c];
-    const double overlap = P.radius[i] - walls_[C.wall_index[c]].distance(P.pos[i]);
-    worst = std::max(worst, overlap / P.radius[i]);
-  }
+  forEachTouching([&](const Touching& t) { worst = std::max(worst, t.overlap / t.min_radius); });
   return worst;
 }
 
@@ -723,8 +701,7 @@ double Simulation<D>::coordinationNumber() const {
 template <int D>
 double Simulation<D>::unbalancedForceRatio() const {
   const auto& P = particles_;
-  const auto& C = contacts_;
-  if (!model_ || !C.valid || C.pairs.row.size() != P.size() + 1) return 0.0;
+  if (!model_) return 0.0;
   double unbalanced = 0.0, contact = 0.0;
   std::size_t free = 0, count = 0;
   for (std::size_t i = 0; i < P.size(); ++i) {
@@ -732,18 +709,12 @@ double Simulation<D>::unbalancedForceRatio() const {
     unbalanced += P.force[i].norm();
     ++free;
   }
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    for (std::uint32_t p = C.pairs.row[i]; p < C.pairs.row[i + 1]; ++p) {
-      const std::uint32_t j = C.pairs.col[p];
-      const double reach = P.radius[i] + P.radius[j];
-      const double overlap = reach - (P.pos[j] - P.pos[i]).norm();
-      if (!(overlap > 0.0)) continue;
-      const double fn = model_->normalForce(P.material[i], P.material[j], overlap,
-                                            P.radius[i] * P.radius[j] / reach);
-      contact += std::sqrt(fn * fn + C.shear[p].squaredNorm());
-      ++count;
-    }
-  }
+  forEachTouching([&](const Touching& t) {
+    if (t.wall) return;
+    const double fn = model_->normalForce(t.mi, t.mj, t.overlap, t.rstar);
+    contact += std::sqrt(fn * fn + t.shear2);
+    ++count;
+  });
   if (count == 0 || free == 0) return 0.0;
   return (unbalanced / static_cast<double>(free)) / (contact / static_cast<double>(count));
 }

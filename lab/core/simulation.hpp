@@ -177,6 +177,17 @@ class Simulation {
   std::string diagnose() const;
   template <class Archive>
   void visit(Archive& ar);
+  // A touching contact as observers see it; `wall` is null for a particle pair.
+  struct Touching {
+    std::size_t i = 0, j = 0;
+    const Wall<D>* wall = nullptr;
+    std::uint16_t mi = 0, mj = 0;
+    double overlap = 0.0, rstar = 0.0, mstar = 0.0, li = 0.0, lj = 0.0, min_radius = 0.0;
+    double shear2 = 0.0;  // squared tangential spring force
+  };
+  // Visits every touching particle pair, then every touching particle-wall contact.
+  template <class F>
+  void forEachTouching(F&& visit) const;
   bool threaded() const { return config_.threads > 1; }
 
   MaterialTable materials_;
