@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "lab/core/dim.hpp"
 
@@ -23,6 +24,29 @@ struct LawState {
   double cn;
   double cs;
 };
+
+// The size of a contact as the laws see it: the effective radius R* = r1 r2 / (r1 + r2)
+// (Hertz), and a cross-section A over a length L for laws set by a modulus (the
+// "deformability" of PFC 5's linear model, k = E A / L): A = pi min(r1, r2)^2 in 3D or
+// 2 min(r1, r2) t in 2D (t the disk thickness), L = r1 + r2; for a particle on a wall
+// R* = r and L = r.
+struct ContactShape {
+  double rstar = 0.0;   // m
+  double area = 0.0;    // m^2
+  double length = 0.0;  // m
+};
+
+template <int D>
+ContactShape pairShape(double ri, double rj, double thickness) {
+  const double rmin = std::min(ri, rj);
+  return {ri * rj / (ri + rj), D == 3 ? std::numbers::pi * rmin * rmin : 2.0 * rmin * thickness,
+          ri + rj};
+}
+
+template <int D>
+ContactShape wallShape(double r, double thickness) {
+  return {r, D == 3 ? std::numbers::pi * r * r : 2.0 * r * thickness, r};
+}
 
 // Energy dissipated in one contact during one step (J).
 struct ContactDissipation {
@@ -45,8 +69,8 @@ struct ContactKinematics {
   double overlap;  // > 0
   Vec<D> vc;       // velocity of j's contact point relative to i's
   double spin_n;   // mean spin of the two bodies about n (3D twist; 0 in 2D)
-  double rstar;    // effective radius
-  double mstar;    // effective mass
+  ContactShape shape;
+  double mstar;  // effective mass
 };
 
 // The shared contact kernel. `fs` is the contact's tangential spring force on j (its
@@ -56,7 +80,7 @@ struct ContactKinematics {
 template <int D, class Law, bool kTrackEnergy>
 inline ContactResult<D> contactForce(const typename Law::Params& p, const ContactKinematics<D>& k,
                                      Vec<D>& fs, double dt, ContactDissipation& diss) {
-  const LawState s = Law::evaluate(p, k.overlap, k.rstar, k.mstar);
+  const LawState s = Law::evaluate(p, k.overlap, k.shape, k.mstar);
   const Vec<D>& n = k.n;
   const double vn = k.vc.dot(n);
   const Vec<D> vt = k.vc - vn * n;
@@ -105,11 +129,11 @@ inline ContactResult<D> contactForce(const typename Law::Params& p, const Contac
 
 // Strain energy stored in a contact: the law's normal energy plus the shear spring's.
 template <class Law>
-inline double contactStrainEnergy(const typename Law::Params& p, double overlap, double rstar,
-                                  double shear_force2, double mstar) {
-  const LawState s = Law::evaluate(p, overlap, rstar, mstar);
+inline double contactStrainEnergy(const typename Law::Params& p, double overlap,
+                                  const ContactShape& g, double shear_force2, double mstar) {
+  const LawState s = Law::evaluate(p, overlap, g, mstar);
   const double es = s.ks > 0.0 ? 0.5 * shear_force2 / s.ks : 0.0;
-  return Law::normalEnergy(p, overlap, rstar) + es;
+  return Law::normalEnergy(p, overlap, g) + es;
 }
 
 }  // namespace rocklab

@@ -23,8 +23,8 @@ struct HertzParams {
 
 struct HertzLaw {
   using Params = HertzParams;
-  static LawState evaluate(const Params& p, double overlap, double rstar, double mstar) {
-    const double a = std::sqrt(rstar * overlap);
+  static LawState evaluate(const Params& p, double overlap, const ContactShape& g, double mstar) {
+    const double a = std::sqrt(g.rstar * overlap);
     LawState s{4.0 / 3.0 * p.estar * a * overlap, 2.0 * p.estar * a, 8.0 * p.gstar * a, 0.0, 0.0};
     if (p.damp != 0.0) {
       const double am = std::sqrt(a * mstar);
@@ -33,13 +33,13 @@ struct HertzLaw {
     }
     return s;
   }
-  static double normalEnergy(const Params& p, double overlap, double rstar) {
-    return 8.0 / 15.0 * p.estar * std::sqrt(rstar) * overlap * overlap * std::sqrt(overlap);
+  static double normalEnergy(const Params& p, double overlap, const ContactShape& g) {
+    return 8.0 / 15.0 * p.estar * std::sqrt(g.rstar) * overlap * overlap * std::sqrt(overlap);
   }
   // Rayleigh wave time across the particle, T_R = pi r sqrt(rho/G) / (0.1631 nu + 0.8766)
   // (Li, Xu & Thornton 2005): the usual bound before contact stiffness is known.
-  static double freeParticleStep(const Params&, const Material& m, double radius, double, double,
-                                 double density) {
+  static double freeParticleStep(const Params&, const ContactShape&, const Material& m,
+                                 double radius, double, double, double density) {
     const double g = m.young / (2.0 * (1.0 + m.poisson));
     return std::numbers::pi * radius * std::sqrt(density / g) / (0.1631 * m.poisson + 0.8766);
   }

@@ -57,18 +57,18 @@ class ContactModel {
   virtual void computeForces(ContactPass<D>& pass) = 0;
   // Tangent normal and shear stiffness (N/m) of a contact at an overlap.
   virtual std::pair<double, double> stiffness(std::uint16_t mi, std::uint16_t mj, double overlap,
-                                              double rstar, double mstar) const = 0;
+                                              const ContactShape& g, double mstar) const = 0;
   // Elastic normal force (N) of a contact at an overlap.
   virtual double normalForce(std::uint16_t mi, std::uint16_t mj, double overlap,
-                             double rstar) const = 0;
+                             const ContactShape& g) const = 0;
   // Elastic energy stored in a contact (J).
-  virtual double strainEnergy(std::uint16_t mi, std::uint16_t mj, double overlap, double rstar,
-                              double mstar, double shear_force2) const = 0;
+  virtual double strainEnergy(std::uint16_t mi, std::uint16_t mj, double overlap,
+                              const ContactShape& g, double mstar, double shear_force2) const = 0;
   // Critical step (s) of a particle that touches nothing yet: it bounds the step before
-  // contacts form (linear: sqrt(m / kn) of a contact with its own kind; Hertz: the Rayleigh
-  // wave time across the particle).
-  virtual double freeParticleStep(std::uint16_t material, double radius, double mass,
-                                  double inertia, double density) const = 0;
+  // contacts form (linear: sqrt(m / kn) of a contact with its own kind, `self` the shape of
+  // that contact; Hertz: the Rayleigh wave time across the particle).
+  virtual double freeParticleStep(std::uint16_t material, const ContactShape& self, double radius,
+                                  double mass, double inertia, double density) const = 0;
 };
 
 // Pair parameters of every material pair, mixed once.

@@ -33,25 +33,25 @@ class ContactModelImpl final : public ContactModel<D> {
   }
 
   std::pair<double, double> stiffness(std::uint16_t mi, std::uint16_t mj, double overlap,
-                                      double rstar, double mstar) const override {
-    const LawState s = Law::evaluate(table_(mi, mj), overlap, rstar, mstar);
+                                      const ContactShape& g, double mstar) const override {
+    const LawState s = Law::evaluate(table_(mi, mj), overlap, g, mstar);
     return {s.kn, s.ks};
   }
 
   double normalForce(std::uint16_t mi, std::uint16_t mj, double overlap,
-                     double rstar) const override {
-    return Law::evaluate(table_(mi, mj), overlap, rstar, 0.0).fn_elastic;
+                     const ContactShape& g) const override {
+    return Law::evaluate(table_(mi, mj), overlap, g, 0.0).fn_elastic;
   }
 
-  double strainEnergy(std::uint16_t mi, std::uint16_t mj, double overlap, double rstar,
+  double strainEnergy(std::uint16_t mi, std::uint16_t mj, double overlap, const ContactShape& g,
                       double mstar, double shear_force2) const override {
-    return contactStrainEnergy<Law>(table_(mi, mj), overlap, rstar, shear_force2, mstar);
+    return contactStrainEnergy<Law>(table_(mi, mj), overlap, g, shear_force2, mstar);
   }
 
-  double freeParticleStep(std::uint16_t material, double radius, double mass, double inertia,
-                          double density) const override {
-    return Law::freeParticleStep(table_(material, material), materials_[material], radius, mass,
-                                 inertia, density);
+  double freeParticleStep(std::uint16_t material, const ContactShape& self, double radius,
+                          double mass, double inertia, double density) const override {
+    return Law::freeParticleStep(table_(material, material), self, materials_[material], radius,
+                                 mass, inertia, density);
   }
 
  private:
@@ -75,6 +75,7 @@ class ContactModelImpl final : public ContactModel<D> {
     const std::uint32_t* col = C.pairs.col.data();
     V* shear = C.shear.data();
     const double dt = pass.dt;
+    const double thickness = P.thickness;
     const double limit = pass.overlap_limit;
 
     auto& B = buffers_;
@@ -125,7 +126,7 @@ class ContactModelImpl final : public ContactModel<D> {
           } else {
             k.spin_n = 0.0;
           }
-          k.rstar = ri * rj / reach;
+          k.shape = pairShape<D>(ri, rj, thickness);
           const double imsum = imi + im[j];
           k.mstar = imsum > 0.0 ? 1.0 / imsum : 0.0;
           over |= static_cast<std::uint8_t>(k.overlap > limit * std::min(ri, rj));
@@ -213,7 +214,7 @@ class ContactModelImpl final : public ContactModel<D> {
       } else {
         k.spin_n = 0.0;
       }
-      k.rstar = ri;
+      k.shape = wallShape<D>(ri, P.thickness);
       k.mstar = P.inv_mass[i] > 0.0 ? 1.0 / P.inv_mass[i] : 0.0;
       pass.overlap_exceeded |= overlap > pass.overlap_limit * ri;
       const ContactResult<D> r = contactForce<D, Law, kEnergy>(table_(P.material[i], w.material), k,

@@ -15,18 +15,21 @@ namespace rocklab {
 // contact_laws.hpp) and validates them before a run starts.
 struct Material {
   std::string name = "default";
-  double density = 2650.0;     // kg/m^3, for scene builders: particles carry their own
-  double young = 70e9;         // Pa, Hertz-Mindlin
-  double poisson = 0.25;       // -, Hertz-Mindlin
-  double kn = 0.0;             // N/m, linear: the particle's normal spring, in series per contact
-  double ks = 0.0;             // N/m, linear: shear spring, in series per contact
-  double friction = 0.5;       // -, Coulomb coefficient
-  double damping_ratio = 0.0;  // -, critical damping ratio of the contact dashpots
+  double density = 2650.0;       // kg/m^3, for scene builders: particles carry their own
+  double young = 70e9;           // Pa, Hertz-Mindlin
+  double poisson = 0.25;         // -, Hertz-Mindlin
+  double kn = 0.0;               // N/m, linear: the particle's normal spring, in series per contact
+  double ks = 0.0;               // N/m, linear: shear spring, in series per contact
+  double modulus = 0.0;          // Pa, linear: contact modulus E, kn = E A / L per contact
+  double stiffness_ratio = 1.0;  // -, linear with a modulus: kn / ks
+  double friction = 0.5;         // -, Coulomb coefficient
+  double damping_ratio = 0.0;    // -, critical damping ratio of the contact dashpots
 
   template <class Archive>
   void visit(Archive& ar) {
     ar("name", name), ar("density", density), ar("young", young), ar("poisson", poisson);
-    ar("kn", kn), ar("ks", ks), ar("friction", friction), ar("damping_ratio", damping_ratio);
+    ar("kn", kn), ar("ks", ks), ar("modulus", modulus), ar("stiffness_ratio", stiffness_ratio),
+        ar("friction", friction), ar("damping_ratio", damping_ratio);
   }
 };
 

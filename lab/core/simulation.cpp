@@ -609,7 +609,7 @@ void Simulation<D>::forEachTouching(F&& visit) const {
       const double imsum = P.inv_mass[i] + P.inv_mass[j];
       t.i = i, t.j = j, t.wall = nullptr;
       t.mi = P.material[i], t.mj = P.material[j];
-      t.rstar = P.radius[i] * P.radius[j] / reach;
+      t.shape = pairShape<D>(P.radius[i], P.radius[j], P.thickness);
       t.mstar = imsum > 0.0 ? 1.0 / imsum : 0.0;
       t.li = P.radius[i] - 0.5 * t.overlap, t.lj = P.radius[j] - 0.5 * t.overlap;
       t.min_radius = std::min(P.radius[i], P.radius[j]);
@@ -624,7 +624,7 @@ void Simulation<D>::forEachTouching(F&& visit) const {
     if (!(t.overlap > 0.0)) continue;
     t.i = i, t.j = i, t.wall = &w;
     t.mi = P.material[i], t.mj = w.material;
-    t.rstar = P.radius[i];
+    t.shape = wallShape<D>(P.radius[i], P.thickness);
     t.mstar = P.inv_mass[i] > 0.0 ? 1.0 / P.inv_mass[i] : 0.0;
     t.li = P.radius[i] - t.overlap, t.lj = 0.0;
     t.min_radius = P.radius[i];
@@ -640,7 +640,7 @@ double Simulation<D>::criticalTimeStep() const {
   if (!model_) throw std::logic_error("criticalTimeStep() before the simulation is prepared");
   std::vector<double> kt(n, 0.0), kr(n, 0.0);
   forEachTouching([&](const Touching& t) {
-    const auto [kn, ks] = model_->stiffness(t.mi, t.mj, t.overlap, t.rstar, t.mstar);
+    const auto [kn, ks] = model_->stiffness(t.mi, t.mj, t.overlap, t.shape, t.mstar);
     kt[t.i] += kn;
     kr[t.i] += ks * t.li * t.li;
     if (!t.wall) {
@@ -652,8 +652,9 @@ double Simulation<D>::criticalTimeStep() const {
   for (std::size_t i = 0; i < n; ++i) {
     if (P.inv_mass[i] == 0.0) continue;
     const double m = 1.0 / P.inv_mass[i], inertia = 1.0 / P.inv_inertia[i];
-    dt = std::min(
-        dt, model_->freeParticleStep(P.material[i], P.radius[i], m, inertia, m / P.volume(i)));
+    dt = std::min(dt, model_->freeParticleStep(P.material[i],
+                                               pairShape<D>(P.radius[i], P.radius[i], P.thickness),
+                                               P.radius[i], m, inertia, m / P.volume(i)));
     if (kt[i] > 0.0) dt = std::min(dt, std::sqrt(m / kt[i]));
     if (kr[i] > 0.0) dt = std::min(dt, std::sqrt(inertia / kr[i]));
   }
@@ -672,7 +673,7 @@ EnergyReport Simulation<D>::energy() const {
   }
   if (!model_) return e;
   forEachTouching([&](const Touching& t) {
-    e.strain += model_->strainEnergy(t.mi, t.mj, t.overlap, t.rstar, t.mstar, t.shear2);
+    e.strain += model_->strainEnergy(t.mi, t.mj, t.overlap, t.shape, t.mstar, t.shear2);
   });
   return e;
 }
@@ -711,7 +712,7 @@ double Simulation<D>::unbalancedForceRatio() const {
   }
   forEachTouching([&](const Touching& t) {
     if (t.wall) return;
-    const double fn = model_->normalForce(t.mi, t.mj, t.overlap, t.rstar);
+    const double fn = model_->normalForce(t.mi, t.mj, t.overlap, t.shape);
     contact += std::sqrt(fn * fn + t.shear2);
     ++count;
   });

@@ -182,7 +182,8 @@ class Simulation {
     std::size_t i = 0, j = 0;
     const Wall<D>* wall = nullptr;
     std::uint16_t mi = 0, mj = 0;
-    double overlap = 0.0, rstar = 0.0, mstar = 0.0, li = 0.0, lj = 0.0, min_radius = 0.0;
+    ContactShape shape;
+    double overlap = 0.0, mstar = 0.0, li = 0.0, lj = 0.0, min_radius = 0.0;
     double shear2 = 0.0;  // squared tangential spring force
   };
   // Visits every touching particle pair, then every touching particle-wall contact.

@@ -14,19 +14,19 @@
 namespace rocklab {
 namespace {
 
-ContactKinematics<3> restingContact(double overlap, double rstar, double mstar) {
+ContactKinematics<3> restingContact(double overlap, double r, double mstar) {
   ContactKinematics<3> k;
   k.n = Eigen::Vector3d::UnitX();
   k.overlap = overlap;
   k.vc = Eigen::Vector3d::Zero();
   k.spin_n = 0.0;
-  k.rstar = rstar;
+  k.shape = pairShape<3>(r, r, 1.0);
   k.mstar = mstar;
   return k;
 }
 
 TEST(LinearLaw, NormalForceIsSpringTimesOverlap) {
-  LinearParams p{1e6, 5e5, 0.5, 0.0};
+  LinearParams p{.kn = 1e6, .ks = 5e5, .mu = 0.5};
   Eigen::Vector3d fs = Eigen::Vector3d::Zero();
   ContactDissipation diss;
   const auto r =
@@ -44,16 +44,17 @@ TEST(HertzLaw, NormalForceMatchesHertz) {
   a.poisson = nu;
   m.add(a);
   auto model = makeContactModel<3>("hertz", m);
+  const ContactShape shape = pairShape<3>(r, r, 1.0);
   const double rstar = r / 2;
   const double estar = e / (2 * (1 - nu * nu));
   const double expected = 4.0 / 3.0 * estar * std::sqrt(rstar) * std::pow(overlap, 1.5);
-  EXPECT_NEAR(model->normalForce(0, 0, overlap, rstar), expected, 1e-12 * expected);
-  const auto [kn, ks] = model->stiffness(0, 0, overlap, rstar, 1.0);
+  EXPECT_NEAR(model->normalForce(0, 0, overlap, shape), expected, 1e-12 * expected);
+  const auto [kn, ks] = model->stiffness(0, 0, overlap, shape, 1.0);
   const double g = e / (2 * (1 + nu)), gstar = g / (2 * (2 - nu));
   EXPECT_NEAR(kn, 2 * estar * std::sqrt(rstar * overlap), 1e-6 * kn);
   EXPECT_NEAR(ks, 8 * gstar * std::sqrt(rstar * overlap), 1e-6 * ks);
   // Strain energy is the integral of the force: 2/5 F overlap for Hertz.
-  EXPECT_NEAR(model->strainEnergy(0, 0, overlap, rstar, 1.0, 0.0), 0.4 * expected * overlap, 1e-12);
+  EXPECT_NEAR(model->strainEnergy(0, 0, overlap, shape, 1.0, 0.0), 0.4 * expected * overlap, 1e-12);
 }
 
 TEST(ContactLaws, MixingRules) {
@@ -65,12 +66,34 @@ TEST(ContactLaws, MixingRules) {
   m.add(b);
   auto lin = makeContactModel<3>("linear", m);
   // Springs in series; a shear spring of 0 on one side gives none.
-  EXPECT_DOUBLE_EQ(lin->stiffness(0, 0, 1e-6, 1e-3, 1.0).first, 1e6);
-  EXPECT_DOUBLE_EQ(lin->stiffness(0, 1, 1e-6, 1e-3, 1.0).second, 0.0);
+  EXPECT_DOUBLE_EQ(lin->stiffness(0, 0, 1e-6, pairShape<3>(1e-3, 1e-3, 1.0), 1.0).first, 1e6);
+  EXPECT_DOUBLE_EQ(lin->stiffness(0, 1, 1e-6, pairShape<3>(1e-3, 1e-3, 1.0), 1.0).second, 0.0);
   EXPECT_DOUBLE_EQ(m.friction(0, 1), 0.2);
   EXPECT_DOUBLE_EQ(m.dampingRatio(0, 1), 0.2);
   m.setPair(0, 1, {0.9, std::nullopt});
   EXPECT_DOUBLE_EQ(m.friction(1, 0), 0.9);
+}
+
+// PFC 5's deformability method: kn = E A / L with A = pi min(r)^2 (3D) or 2 min(r) t (2D)
+// and L = r1 + r2; ks = kn / ratio.
+TEST(ContactLaws, LinearStiffnessFromAModulus) {
+  MaterialTable m;
+  Material a;
+  a.modulus = 4e9;
+  a.stiffness_ratio = 2.0;
+  m.add(a);
+  const double r1 = 1e-3, r2 = 3e-3;
+  const auto [kn, ks] =
+      makeContactModel<3>("linear", m)->stiffness(0, 0, 1e-6, pairShape<3>(r1, r2, 1.0), 1.0);
+  EXPECT_NEAR(kn, 4e9 * M_PI * r1 * r1 / (r1 + r2), 1e-9 * kn);
+  EXPECT_NEAR(ks, kn / 2.0, 1e-9 * kn);
+  const auto [kn2, ks2] =
+      makeContactModel<2>("linear", m)->stiffness(0, 0, 1e-6, pairShape<2>(r1, r2, 0.5), 1.0);
+  EXPECT_NEAR(kn2, 4e9 * 2 * r1 * 0.5 / (r1 + r2), 1e-9 * kn2);
+  // On a wall, L is the particle's radius.
+  const auto [knw, ksw] =
+      makeContactModel<3>("linear", m)->stiffness(0, 0, 1e-6, wallShape<3>(r1, 1.0), 1.0);
+  EXPECT_NEAR(knw, 4e9 * M_PI * r1, 1e-9 * knw);
 }
 
 TEST(ContactLaws, RegistryNamesLawsAndValidationNamesTheKey) {
@@ -99,7 +122,7 @@ TEST(ContactLaws, RegistryNamesLawsAndValidationNamesTheKey) {
 
 TEST(ContactKernel, CoulombCapsTheShearForceAndDissipatesSlip) {
   const double kn = 1e6, ks = 1e6, mu = 0.3, overlap = 1e-6, dt = 1e-6;
-  LinearParams p{kn, ks, mu, 0.0};
+  LinearParams p{.kn = kn, .ks = ks, .mu = mu};
   auto k = restingContact(overlap, 1e-3, 1e-3);
   k.vc = {0.0, 2.0, 0.0};  // fast tangential motion: slides at once
   Eigen::Vector3d fs = Eigen::Vector3d::Zero();
@@ -120,7 +143,7 @@ TEST(ContactKernel, CoulombCapsTheShearForceAndDissipatesSlip) {
 
 TEST(ContactKernel, ViscousDissipationIsDashpotPower) {
   const double kn = 1e6, beta = 0.3, m = 1e-3, vn = -0.5;
-  LinearParams p{kn, 0.0, 0.5, 2 * beta};
+  LinearParams p{.kn = kn, .ks = 0.0, .mu = 0.5, .damp = 2 * beta};
   auto k = restingContact(1e-6, 1e-3, m);
   k.vc = {vn, 0.0, 0.0};
   Eigen::Vector3d fs = Eigen::Vector3d::Zero();
@@ -134,13 +157,13 @@ TEST(ContactKernel, ViscousDissipationIsDashpotPower) {
 // Rotating the whole contact (normal, relative velocity and stored spring force) rotates
 // the result: the kernel has no preferred frame.
 TEST(ContactKernel, FrameInvariant) {
-  HertzParams p{37e9, 8e9, 0.4, 0.1};
+  HertzParams p{.estar = 37e9, .gstar = 8e9, .mu = 0.4, .damp = 0.1};
   ContactKinematics<3> k;
   k.n = Eigen::Vector3d(1, 2, 2).normalized();
   k.overlap = 3e-6;
   k.vc = Eigen::Vector3d(0.01, -0.03, 0.02);
   k.spin_n = 40.0;
-  k.rstar = 5e-4;
+  k.shape = pairShape<3>(1e-3, 1e-3, 1.0);
   k.mstar = 4e-6;
   Eigen::Vector3d fs = Eigen::Vector3d(0.2, 0.1, -0.2);
   fs -= fs.dot(k.n) * k.n;
@@ -161,7 +184,7 @@ TEST(ContactKernel, FrameInvariant) {
 // The stored spring force turns with the bodies' spin about the normal and is carried
 // into a tilted tangent plane with its magnitude.
 TEST(ContactKernel, HistoryFollowsTheContactFrame) {
-  LinearParams p{1e6, 1e6, 10.0, 0.0};
+  LinearParams p{.kn = 1e6, .ks = 1e6, .mu = 10.0};
   ContactKinematics<3> k = restingContact(1e-6, 1e-3, 1e-3);
   Eigen::Vector3d fs(0.0, 0.5, 0.0);
   const double dt = 1e-4, spin = 10.0;
@@ -180,13 +203,13 @@ TEST(ContactKernel, HistoryFollowsTheContactFrame) {
 }
 
 TEST(ContactKernel, TwoDimensionalShearAndTorqueSign) {
-  LinearParams p{1e6, 1e6, 0.5, 0.0};
+  LinearParams p{.kn = 1e6, .ks = 1e6, .mu = 0.5};
   ContactKinematics<2> k;
   k.n = Eigen::Vector2d::UnitX();
   k.overlap = 1e-6;
   k.vc = {0.0, 0.1};
   k.spin_n = 0.0;
-  k.rstar = 5e-4;
+  k.shape = pairShape<2>(1e-3, 1e-3, 1.0);
   k.mstar = 1e-3;
   Eigen::Vector2d fs = Eigen::Vector2d::Zero();
   ContactDissipation d;
