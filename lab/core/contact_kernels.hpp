@@ -73,6 +73,20 @@ struct ContactKinematics {
   double mstar;  // effective mass
 };
 
+// Keeps a vector stored with a contact (a spring force, a bond moment) in the contact's
+// tangent plane as the contact turns: turned with the bodies' mean spin about the normal,
+// then projected on the new tangent plane with its magnitude kept (Cundall & Strack 1979;
+// cf. Yade ScGeom::rotate). First order in the angle turned per step.
+template <int D>
+inline void followContactFrame(Vec<D>& v, const Vec<D>& n, double spin_n, double dt) {
+  const double m2 = v.squaredNorm();
+  if (m2 == 0.0) return;
+  if constexpr (D == 3) v += (dt * spin_n) * n.cross(v);
+  v -= v.dot(n) * n;
+  const double m2_new = v.squaredNorm();
+  if (m2_new > 0.0) v *= std::sqrt(m2 / m2_new);
+}
+
 // The shared contact kernel. `fs` is the contact's tangential spring force on j (its
 // history); it is rotated with the contact (objectivity), incremented by -ks * vt * dt,
 // and capped at mu * Fn (Coulomb). When sliding, the shear dashpot is inactive so that
@@ -86,18 +100,8 @@ inline ContactResult<D> contactForce(const typename Law::Params& p, const Contac
   const Vec<D> vt = k.vc - vn * n;
   const double fn = s.fn_elastic - s.cn * vn;
 
-  // Keep the stored spring force in the current tangent plane with its magnitude, and turn
-  // it with the bodies' spin about the normal, so a rigidly rotated contact keeps its
-  // force (Cundall & Strack 1979; cf. Yade ScGeom::rotate).
-  const double fs2_old = fs.squaredNorm();
-  if (fs2_old > 0.0) {
-    if constexpr (D == 3) {
-      fs += (dt * k.spin_n) * n.cross(fs);
-    }
-    fs -= fs.dot(n) * n;
-    const double fs2_new = fs.squaredNorm();
-    if (fs2_new > 0.0) fs *= std::sqrt(fs2_old / fs2_new);
-  }
+  // A rigidly rotated contact keeps its force.
+  followContactFrame<D>(fs, n, k.spin_n, dt);
   const Vec<D> fs_rotated = fs;
   fs -= (s.ks * dt) * vt;
 

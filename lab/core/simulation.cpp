@@ -200,12 +200,13 @@ void Simulation<D>::prepare() {
       dt_ = config_.timestep.fixed_dt;
     }
   }
+    prepared_ = true;
   if (!ledger_.started) restartEnergyLedger();
-  prepared_ = true;
 }
 
 template <int D>
 void Simulation<D>::restartEnergyLedger() {
+  if (!prepared_) prepare();  // the strain energy needs the contact model and the contacts
   ledger_ = EnergyLedger{};
   const EnergyReport e = energy();
   ledger_.initial = e.kinetic() + e.strain;
@@ -249,6 +250,7 @@ bool Simulation<D>::computeForces(double history_dt) {
   ledger_.friction += pass.friction;
   ledger_.viscous += pass.viscous;
   const auto t2 = std::chrono::steady_clock::now();
+  if (bonds_.size() > 0) computeBondForces(history_dt);
   if (gravity) {
     stage_seconds_[kBodyForces] += std::chrono::duration<double>(t1 - t0).count();
     ++stage_calls_[kBodyForces];
@@ -256,6 +258,121 @@ bool Simulation<D>::computeForces(double history_dt) {
   stage_seconds_[kContacts] += std::chrono::duration<double>(t2 - t1).count();
   ++stage_calls_[kContacts];
   return pass.overlap_exceeded;
+}
+
+template <int D>
+void Simulation<D>::computeBondForces(double dt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto& P = particles_;
+  BondPass<D> pass{P, bonds_, dt, threaded(), config_.threads, {}, {}, {}};
+  bond_forces_.compute(pass);
+  if (!pass.broken.empty()) {
+    // Second phase: log and remove the broken bonds in bond order.
+    std::vector<std::uint8_t> flag(bonds_.size(), 0);
+    for (std::size_t k = 0; k < pass.broken.size(); ++k) {
+      const std::uint32_t b = pass.broken[k];
+      const std::uint32_t i = bonds_.i[b], j = bonds_.j[b];
+      const auto section = BondSection<D>::of(bonds_.radius[b], P.thickness);
+      ledger_.bond_breakage += bondEnergy<D>(section, bonds_.kn[b], bonds_.ks[b], bonds_.load[b]);
+      const V d = P.pos[j] - P.pos[i];
+      const double dist = d.norm();
+      const double overlap = P.radius[i] + P.radius[j] - dist;
+      BondBreak<D> e;
+      e.step = step_;
+      e.time = time_;
+      e.position = P.pos[i] + (P.radius[i] - 0.5 * overlap) / dist * d;
+      e.mode = pass.modes[k];
+      e.a = P.id(i);
+      e.b = P.id(j);
+      e.kind = bonds_.kind[b];
+      e.stress = pass.stresses[k];
+      bond_breaks_.push_back(e);
+      ++broken_counts_[2 * e.kind + (e.mode == BondBreakMode::Shear ? 1 : 0)];
+      flag[b] = 1;
+    }
+    bonds_.removeFlagged(flag);
+    bond_forces_.invalidate();
+  }
+  stage_seconds_[kBonds] +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ++stage_calls_[kBonds];
+}
+
+template <int D>
+std::uint8_t Simulation<D>::addBondKind(BondKind kind) {
+  kind.validate();
+  if (bond_kinds_.size() >= 255) throw std::invalid_argument("at most 255 bond kinds");
+  bond_kinds_.push_back(std::move(kind));
+  broken_counts_.resize(2 * bond_kinds_.size(), 0);
+  return static_cast<std::uint8_t>(bond_kinds_.size() - 1);
+}
+
+template <int D>
+std::uint64_t Simulation<D>::brokenBonds(std::uint8_t kind, BondBreakMode mode) const {
+  return broken_counts_.at(2 * kind + (mode == BondBreakMode::Shear ? 1 : 0));
+}
+
+template <int D>
+CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
+  const BondKind& kind = bond_kinds_.at(kind_index);
+  requireRange("cementing", "gap_ratio", gap_ratio, 0.0, false, 1.0, false, "-");
+  auto& P = particles_;
+  CementReport report;
+  if (P.size() < 2) return report;
+  double rmax = 0.0;
+  for (double r : P.radius) rmax = std::max(rmax, r);
+  PairRows rows;
+  NeighborGrid<D> grid;
+  grid.build(P.pos, P.radius, gap_ratio * rmax, rows);
+
+  std::vector<std::uint64_t> existing;
+  for (std::size_t b = 0; b < bonds_.size(); ++b) {
+    existing.push_back(std::uint64_t{bonds_.i[b]} << 32 | bonds_.j[b]);
+  }
+  std::sort(existing.begin(), existing.end());
+  auto draw = [&](double mean, double sd, bool& skip) {
+    double s = rng_.normal(mean, sd);
+    while (s <= 0.0 && kind.negative == NegativeStrength::Resample) {
+      ++report.redrawn;
+      s = rng_.normal(mean, sd);
+    }
+    skip = skip || s <= 0.0;
+    return s;
+  };
+  for (std::uint32_t i = 0; i + 1 < rows.row.size(); ++i) {
+    for (std::uint32_t p = rows.row[i]; p < rows.row[i + 1]; ++p) {
+      const std::uint32_t j = rows.col[p];
+      const double gap = (P.pos[j] - P.pos[i]).norm() - P.radius[i] - P.radius[j];
+      const double rmin = std::min(P.radius[i], P.radius[j]);
+      if (gap >= gap_ratio * rmin) continue;
+      ++report.candidates;
+      if (std::binary_search(existing.begin(), existing.end(), std::uint64_t{i} << 32 | j)) {
+        continue;
+      }
+      bool skip = false;
+      const double tensile = draw(kind.tensile_mean, kind.tensile_std, skip);
+      const double shear = draw(kind.shear_mean, kind.shear_std, skip);
+      if (skip) {
+        ++report.skipped_nonpositive;
+        continue;
+      }
+      bonds_.i.push_back(i);
+      bonds_.j.push_back(j);
+      bonds_.kind.push_back(kind_index);
+      bonds_.radius.push_back(kind.radius_multiplier * rmin);
+      // Stiffness per area from the bond modulus over the pair's length (PFC 5's linear
+      // parallel bond, deformability method: kn = E / L, L = r1 + r2).
+      const double kn = kind.modulus / (P.radius[i] + P.radius[j]);
+      bonds_.kn.push_back(kn);
+      bonds_.ks.push_back(kn / kind.stiffness_ratio);
+      bonds_.tensile.push_back(tensile);
+      bonds_.shear.push_back(shear);
+      bonds_.load.push_back(BondLoad<D>{});
+      ++report.installed;
+    }
+  }
+  bond_forces_.invalidate();
+  return report;
 }
 
 template <int D>
@@ -408,6 +525,25 @@ void Simulation<D>::rebuild() {
   if (config_.spatial_sort && n > 1) {
     const auto order = NeighborGrid<D>::spatialOrder(P.pos, P.radius);
     P.permute(order);
+    if (bonds_.size() > 0) {
+      std::vector<std::uint32_t> new_index(n);
+      for (std::uint32_t k = 0; k < n; ++k) new_index[order[k]] = k;
+      for (std::size_t b = 0; b < bonds_.size(); ++b) {
+        std::uint32_t a = new_index[bonds_.i[b]], c = new_index[bonds_.j[b]];
+        if (a > c) {
+                    // Keep i < j: seen from the other particle, the shear force and bending moment on
+          // j change sign; the normal force and the twist (a moment about n, which flips
+          // too) do not.
+          std::swap(a, c);
+          BondLoad<D>& l = bonds_.load[b];
+          l.fs = -l.fs;
+          l.mb = -l.mb;
+        }
+        bonds_.i[b] = a;
+        bonds_.j[b] = c;
+      }
+      bond_forces_.invalidate();
+    }
     if (!damp_force_.empty()) {
       auto apply = [&](auto& v) {
         std::remove_reference_t<decltype(v)> out(v.size());
@@ -648,6 +784,16 @@ double Simulation<D>::criticalTimeStep() const {
       kr[t.j] += ks * t.lj * t.lj;
     }
   });
+  // Bonds add their normal stiffness to translation, shear and bending to rotation.
+  for (std::size_t b = 0; b < bonds_.size(); ++b) {
+    const auto s = BondSection<D>::of(bonds_.radius[b], P.thickness);
+        const double kn = bonds_.kn[b] * s.area, ks = bonds_.ks[b] * s.area;
+    const double moment = bonds_.kn[b] * s.inertia + bonds_.ks[b] * s.polar;
+    for (const std::uint32_t p : {bonds_.i[b], bonds_.j[b]}) {
+      kt[p] += kn;
+      kr[p] += ks * P.radius[p] * P.radius[p] + moment;
+    }
+  }
   double dt = INFINITY;
   for (std::size_t i = 0; i < n; ++i) {
     if (P.inv_mass[i] == 0.0) continue;
@@ -675,6 +821,10 @@ EnergyReport Simulation<D>::energy() const {
   forEachTouching([&](const Touching& t) {
     e.strain += model_->strainEnergy(t.mi, t.mj, t.overlap, t.shape, t.mstar, t.shear2);
   });
+  for (std::size_t b = 0; b < bonds_.size(); ++b) {
+    const auto s = BondSection<D>::of(bonds_.radius[b], P.thickness);
+    e.strain += bondEnergy<D>(s, bonds_.kn[b], bonds_.ks[b], bonds_.load[b]);
+  }
   return e;
 }
 
@@ -722,8 +872,8 @@ double Simulation<D>::unbalancedForceRatio() const {
 
 template <int D>
 std::vector<StageTiming> Simulation<D>::stageTimings() const {
-  static constexpr const char* kNames[kStages] = {"integrate", "neighbors",  "body_forces",
-                                                  "contacts",  "wall_servo", "guard"};
+  static constexpr const char* kNames[kStages] = {
+      "integrate", "neighbors", "body_forces", "contacts", "bonds", "wall_servo", "guard"};
   std::vector<StageTiming> out;
   for (int s = 0; s < kStages; ++s) {
     if (stage_calls_[s] == 0) continue;  // a stage the scene does not call for never ran
@@ -743,6 +893,16 @@ std::uint64_t Simulation<D>::stateHash() const {
   h = hashVector(P.torque, h);
   h = hashVector(contacts_.shear, h);
   h = hashVector(contacts_.wall_shear, h);
+  for (const BondLoad<D>& l : bonds_.load) {
+    h = fnv1a(&l.fn, sizeof l.fn, h);
+    h = fnv1a(l.fs.data(), sizeof(double) * D, h);
+    if constexpr (D == 3) {
+      h = fnv1a(l.mb.data(), sizeof(double) * 3, h);
+      h = fnv1a(&l.mt, sizeof l.mt, h);
+    } else {
+      h = fnv1a(&l.mb, sizeof l.mb, h);
+    }
+  }
   for (const auto& w : walls_) {
     h = fnv1a(w.point.data(), sizeof(double) * D, h);
     h = fnv1a(w.velocity.data(), sizeof(double) * D, h);
@@ -798,6 +958,9 @@ void Simulation<D>::visit(Archive& ar) {
   ar("ledger.body_work", ledger_.body_work), ar("ledger.friction", ledger_.friction);
   ar("ledger.viscous", ledger_.viscous), ar("ledger.local_damping", ledger_.local_damping);
   ar("ledger.positive_input", ledger_.positive_input), ar("ledger.started", ledger_.started);
+  ar("ledger.bond_breakage", ledger_.bond_breakage);
+  ar("bond_kinds", bond_kinds_), ar("bonds", bonds_), ar("bond_breaks", bond_breaks_);
+  ar("broken_counts", broken_counts_);
   ar("time", time_), ar("dt", dt_), ar("step", step_), ar("kinetic", kinetic_);
   ar("forces_valid", forces_valid_);
   ar("damp_force", damp_force_), ar("damp_torque", damp_torque_);

@@ -14,8 +14,11 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "lab/core/bond_forces.hpp"
+#include "lab/core/bonds.hpp"
 #include "lab/core/contact_model.hpp"
 #include "lab/core/contacts.hpp"
 #include "lab/core/material.hpp"
@@ -60,6 +63,7 @@ struct EnergyLedger {
   double friction = 0.0;        // dissipated by Coulomb sliding
   double viscous = 0.0;         // dissipated by contact dashpots
   double local_damping = 0.0;   // dissipated by local (non-viscous) damping
+  double bond_breakage = 0.0;   // elastic energy bonds held when they broke
   double positive_input = 0.0;  // energy put in (for the runaway guard)
   bool started = false;
 };
@@ -72,8 +76,8 @@ struct EnergyReport {
   double kinetic() const { return kinetic_translation + kinetic_rotation; }
   // Energy now held or dissipated, minus the energy that came in: zero for an exact scheme.
   double imbalance() const {
-    return kinetic() + strain + ledger.friction + ledger.viscous + ledger.local_damping -
-           (ledger.initial + ledger.boundary_work + ledger.body_work);
+    return kinetic() + strain + ledger.friction + ledger.viscous + ledger.local_damping +
+           ledger.bond_breakage - (ledger.initial + ledger.boundary_work + ledger.body_work);
   }
 };
 
@@ -131,6 +135,20 @@ class Simulation {
   void restartEnergyLedger();
   Rng& rng() { return rng_; }
 
+  // --- cement ---
+  std::uint8_t addBondKind(BondKind kind);
+  const std::vector<BondKind>& bondKinds() const { return bond_kinds_; }
+  // Installs a bond of `kind` with zero load on every particle pair that touches or whose
+  // gap is below gap_ratio times the smaller radius (the sample is "formed under stress":
+  // the bonds take only what comes after). Strengths are drawn per bond from the scene's
+  // random stream. Pairs already bonded are left as they are.
+  CementReport cement(std::uint8_t kind, double gap_ratio);
+  const BondStore<D>& bonds() const { return bonds_; }
+  // Bonds broken so far of a kind and mode.
+  std::uint64_t brokenBonds(std::uint8_t kind, BondBreakMode mode) const;
+  // The breaks logged since the last call, oldest first (hands them to the notebook).
+  std::vector<BondBreak<D>> takeBondBreaks() { return std::exchange(bond_breaks_, {}); }
+
   // --- running ---
   void step();
   void run(std::uint64_t steps);
@@ -161,13 +179,14 @@ class Simulation {
   static constexpr std::uint32_t kCheckpointVersion = 1;
 
  private:
-  enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kServo, kGuard, kStages };
+  enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };
 
   void prepare();
   // Forces and torques at the present positions. With history_dt = 0 the contact history
   // does not advance (the set-up evaluation that velocity Verlet needs before its first
   // step); returns whether an overlap exceeded the guard's limit.
   bool computeForces(double history_dt);
+  void computeBondForces(double dt);
   void initialIntegrate();
   void finalIntegrate();
   bool needsRebuild();
@@ -201,6 +220,11 @@ class Simulation {
   std::unique_ptr<ContactModel<D>> model_;
   Rng rng_;
   EnergyLedger ledger_;
+  std::vector<BondKind> bond_kinds_;
+  BondStore<D> bonds_;
+  BondForces<D> bond_forces_;
+  std::vector<BondBreak<D>> bond_breaks_;
+  std::vector<std::uint64_t> broken_counts_;  // 2 per kind: tensile, shear
 
   double time_ = 0.0;
   double dt_ = 0.0;

@@ -78,23 +78,25 @@ TEST(Cli, BenchGivesTheSameStateOnOneAndTwoThreads) {
 TEST(Cli, BenchAgreesWithLiggghts) {
   const std::string dir = std::string(ROCKLAB_SOURCE_DIR) + "/data/peers/";
   std::ifstream ref_file(dir + "liggghts-3.8-packing_3k.json");
-  const std::string ref((std::istreambuf_iterator<char>(ref_file)), std::istreambuf_iterator<char>());
+  const std::string ref((std::istreambuf_iterator<char>(ref_file)),
+                        std::istreambuf_iterator<char>());
   auto number = [](const std::string& text, const std::string& key) {
     std::smatch m;
-    EXPECT_TRUE(std::regex_search(text, m, std::regex("\"" + key + "\": \\[?([-0-9.e+]+)")))
-        << key;
+    EXPECT_TRUE(std::regex_search(text, m, std::regex("\"" + key + "\": \\[?([-0-9.e+]+)"))) << key;
     return std::stod(m[1]);
   };
   auto mean3 = [](const std::string& text, const std::string& key) {
     std::smatch m;
-    std::regex_search(text, m, std::regex("\"" + key + "\": \\[([-0-9.e+]+), ([-0-9.e+]+), ([-0-9.e+]+)\\]"));
+    std::regex_search(
+        text, m, std::regex("\"" + key + "\": \\[([-0-9.e+]+), ([-0-9.e+]+), ([-0-9.e+]+)\\]"));
     return (std::stod(m[1]) + std::stod(m[2]) + std::stod(m[3])) / 3.0;
   };
   const auto r = run("bench --packing " + dir + "packing_3k.txt --json");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NEAR(number(r.out, "coordination_start") / number(ref, "coordination_start"), 1.0, 0.005);
   EXPECT_NEAR(number(r.out, "coordination_end") / number(ref, "coordination_end"), 1.0, 0.005);
-  EXPECT_NEAR(number(r.out, "wall_stress_start_Pa") / mean3(ref, "wall_stress_start_Pa"), 1.0, 0.01);
+  EXPECT_NEAR(number(r.out, "wall_stress_start_Pa") / mean3(ref, "wall_stress_start_Pa"), 1.0,
+              0.01);
   EXPECT_NEAR(number(r.out, "wall_stress_end_Pa") / mean3(ref, "wall_stress_end_Pa"), 1.0, 0.01);
 }
 

@@ -76,6 +76,11 @@ Simulation<3> scene() {
     testing::addParticle<3>(sim, p.centers[i], p.radii[i], V3::Zero());
   }
   testing::addBox<3>(sim, p.lo, p.hi);
+  BondKind cement;
+  cement.modulus = 1e8;
+  cement.tensile_mean = cement.shear_mean = 2e4;
+  cement.tensile_std = cement.shear_std = 2e4;
+  sim.cement(sim.addBondKind(cement), 0.2);
   for (int w = 0; w < 6; ++w) {
     ServoControl& s = sim.wall(w).servo;
     s.enabled = true;
@@ -94,6 +99,8 @@ TEST(Checkpoint, RestartContinuesBitForBit) {
   a.run(900);
   ASSERT_GT(a.contacts().rebuilds, 2u);
   ASSERT_GT(a.particleContacts(), 100u);
+  ASSERT_GT(a.bonds().size(), 0u);
+  ASSERT_GT(a.brokenBonds(0, BondBreakMode::Tensile) + a.brokenBonds(0, BondBreakMode::Shear), 0u);
 
   Simulation<3> b = Simulation<3>::loadCheckpoint(path);
   EXPECT_EQ(b.steps(), 700u);
@@ -101,6 +108,8 @@ TEST(Checkpoint, RestartContinuesBitForBit) {
   EXPECT_EQ(a.stateHash(), b.stateHash());
   EXPECT_EQ(a.time(), b.time());
   EXPECT_EQ(a.energy().ledger.viscous, b.energy().ledger.viscous);
+  EXPECT_EQ(a.bonds().size(), b.bonds().size());
+  EXPECT_EQ(a.takeBondBreaks().size(), b.takeBondBreaks().size());
   std::filesystem::remove(path);
 }
 

@@ -1,0 +1,154 @@
+#include "lab/core/bond_forces.hpp"
+
+#include "lab/core/contact_model.hpp"
+#include "lab/core/errors.hpp"
+
+namespace rocklab {
+
+void BondKind::validate() const {
+  const std::string where = "bond kind '" + name + "'";
+  requireRange(where, "modulus", modulus, 0.0, true, INFINITY, true, "Pa");
+  requireRange(where, "stiffness_ratio", stiffness_ratio, 0.0, true, INFINITY, true, "-");
+  requireRange(where, "radius_multiplier", radius_multiplier, 0.0, true, 10.0, false, "-");
+  requireRange(where, "tensile_std", tensile_std, 0.0, false, INFINITY, true, "Pa");
+  requireRange(where, "shear_std", shear_std, 0.0, false, INFINITY, true, "Pa");
+  // A mean at or below zero with Resample would loop for ever drawing a positive strength.
+  const double lo = negative == NegativeStrength::Resample ? 0.0 : -INFINITY;
+  requireRange(where, "tensile_mean", tensile_mean, lo, true, INFINITY, true, "Pa");
+  requireRange(where, "shear_mean", shear_mean, lo, true, INFINITY, true, "Pa");
+}
+
+template <int D>
+void BondStore<D>::removeFlagged(const std::vector<std::uint8_t>& broken) {
+  std::size_t out = 0;
+  for (std::size_t b = 0; b < size(); ++b) {
+    if (broken[b]) continue;
+    if (out != b) {
+      i[out] = i[b], j[out] = j[b], kind[out] = kind[b], radius[out] = radius[b];
+      kn[out] = kn[b], ks[out] = ks[b], tensile[out] = tensile[b], shear[out] = shear[b];
+      load[out] = load[b];
+    }
+    ++out;
+  }
+  i.resize(out), j.resize(out), kind.resize(out), radius.resize(out), kn.resize(out);
+  ks.resize(out), tensile.resize(out), shear.resize(out), load.resize(out);
+}
+
+template <int D>
+void BondForces<D>::buildAdjacency(std::size_t particles, const BondStore<D>& bonds) {
+  adjacency_row_.assign(particles + 1, 0);
+  for (std::size_t b = 0; b < bonds.size(); ++b) {
+    ++adjacency_row_[bonds.i[b] + 1];
+    ++adjacency_row_[bonds.j[b] + 1];
+  }
+  for (std::size_t k = 0; k < particles; ++k) adjacency_row_[k + 1] += adjacency_row_[k];
+  adjacency_.resize(2 * bonds.size());
+  std::vector<std::uint32_t> fill(adjacency_row_.begin(), adjacency_row_.end() - 1);
+  for (std::uint32_t b = 0; b < bonds.size(); ++b) {
+    adjacency_[fill[bonds.i[b]]++] = b << 1;
+    adjacency_[fill[bonds.j[b]]++] = b << 1 | 1u;
+  }
+  adjacency_valid_ = true;
+}
+
+template <int D>
+void BondForces<D>::compute(BondPass<D>& pass) {
+  auto& P = pass.particles;
+  auto& B = pass.bonds;
+  const std::size_t nb = B.size();
+  const std::size_t blocks = (nb + kBlockRows - 1) / kBlockRows;
+  const double dt = pass.dt;
+  block_broken_.assign(blocks, {});
+  block_modes_.assign(blocks, {});
+  if (pass.threaded) {
+    active_.resize(nb);
+    force_.resize(nb);
+    torque_i_.resize(nb);
+    torque_j_.resize(nb);
+    if (!adjacency_valid_) buildAdjacency(P.size(), B);
+  }
+
+#pragma omp parallel for schedule(dynamic, 1) num_threads(pass.threads) if (pass.threaded)
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    const std::size_t end = std::min(nb, (blk + 1) * kBlockRows);
+    for (std::size_t b = blk * kBlockRows; b < end; ++b) {
+      const std::uint32_t i = B.i[b], j = B.j[b];
+      const Vec<D> d = P.pos[j] - P.pos[i];
+      const double dist = d.norm();
+      BondKinematics<D> k;
+      k.n = d / dist;
+      const double overlap = P.radius[i] + P.radius[j] - dist;  // < 0: a gap
+      const double li = P.radius[i] - 0.5 * overlap, lj = P.radius[j] - 0.5 * overlap;
+      k.vc = P.vel[j] - P.vel[i] - cross(Ang<D>(lj * P.spin[j] + li * P.spin[i]), k.n);
+      k.dspin = P.spin[j] - P.spin[i];
+      if constexpr (D == 3) {
+        k.spin_n = 0.5 * spinAbout(Ang<D>(P.spin[i] + P.spin[j]), k.n);
+      } else {
+        k.spin_n = 0.0;
+      }
+      const auto section = BondSection<D>::of(B.radius[b], P.thickness);
+      const BondResult<D> r = bondForce<D>(section, B.kn[b], B.ks[b], k, B.load[b], dt);
+
+      // A bond at or past its strength breaks now and carries nothing more (the larger
+      // ratio of stress to strength names the mode when both are reached).
+      const double rt = r.tensile / B.tensile[b], rs = r.shear / B.shear[b];
+      if (r.tensile >= B.tensile[b] || r.shear >= B.shear[b]) {
+        const bool tensile = r.tensile >= B.tensile[b] && (r.shear < B.shear[b] || rt >= rs);
+        block_broken_[blk].push_back(static_cast<std::uint32_t>(b));
+        block_modes_[blk].push_back({tensile ? BondBreakMode::Tensile : BondBreakMode::Shear,
+                                     tensile ? r.tensile : r.shear});
+        if (pass.threaded) active_[b] = 0;
+        continue;
+      }
+      const Ang<D> ncf = cross(k.n, B.load[b].fs);
+      const Ang<D> ti = li * ncf + r.moment;  // subtracted from i
+      const Ang<D> tj = r.moment - lj * ncf;  // added to j
+      if (pass.threaded) {
+        active_[b] = 1;
+        force_[b] = r.force;
+        torque_i_[b] = ti;
+        torque_j_[b] = tj;
+      } else {
+        P.force[i] -= r.force;
+        P.force[j] += r.force;
+        P.torque[i] -= ti;
+        P.torque[j] += tj;
+      }
+    }
+  }
+
+  if (pass.threaded) {
+#pragma omp parallel for schedule(static) num_threads(pass.threads)
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      Vec<D> f = P.force[p];
+      Ang<D> t = P.torque[p];
+      for (std::uint32_t q = adjacency_row_[p]; q < adjacency_row_[p + 1]; ++q) {
+        const std::uint32_t b = adjacency_[q] >> 1;
+        if (!active_[b]) continue;
+        if (adjacency_[q] & 1u) {
+          f += force_[b];
+          t += torque_j_[b];
+        } else {
+          f -= force_[b];
+          t -= torque_i_[b];
+        }
+      }
+      P.force[p] = f;
+      P.torque[p] = t;
+    }
+  }
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    for (std::size_t k = 0; k < block_broken_[blk].size(); ++k) {
+      pass.broken.push_back(block_broken_[blk][k]);
+      pass.modes.push_back(block_modes_[blk][k].first);
+      pass.stresses.push_back(block_modes_[blk][k].second);
+    }
+  }
+}
+
+template struct BondStore<2>;
+template struct BondStore<3>;
+template class BondForces<2>;
+template class BondForces<3>;
+
+}  // namespace rocklab

@@ -1,0 +1,305 @@
+// Parallel bonds: stiffness in each mode against the beam formulas of Potyondy & Cundall
+// (2004), breaks at the strength within one step's increment, strength draws, and bonds
+// through particle reordering.
+
+#include <gtest/gtest.h>
+
+#include <numbers>
+
+#include "lab/core/errors.hpp"
+#include "tests/support.hpp"
+
+namespace rocklab {
+namespace {
+
+using V3 = Eigen::Vector3d;
+using V2 = Eigen::Vector2d;
+constexpr double kR = 1e-3, kGap = 2e-6, kModulus = 4e9, kRatio = 0.5, kDt = 1e-7;
+
+BondKind cement(double tensile, double shear, double lambda = 1.0) {
+  BondKind k;
+  k.modulus = kModulus;
+  k.stiffness_ratio = kRatio;
+  k.radius_multiplier = lambda;
+  k.tensile_mean = tensile;
+  k.shear_mean = shear;
+  return k;
+}
+
+// Two driven (fixed) particles with a small gap, so that only the bond acts, then bonded.
+template <int D>
+struct BondedPair {
+  Simulation<D> sim;
+  ParticleId a, b;
+  Vec<D> n;
+  explicit BondedPair(const BondKind& kind)
+      : sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), config()) {
+    n = Vec<D>::Zero();
+    n[0] = 1.0;
+    ParticleSpec<D> p;
+    p.radius = kR;
+    p.fixed = true;
+    a = sim.particles().add(p);
+    p.position = (2 * kR + kGap) * n;
+    b = sim.particles().add(p);
+    const auto k = sim.addBondKind(kind);
+    const CementReport r = sim.cement(k, 0.01);
+    EXPECT_EQ(r.installed, 1u);
+  }
+  static SimulationConfig config() {
+    SimulationConfig c;
+    c.timestep.automatic = false;
+    c.timestep.fixed_dt = kDt;
+    return c;
+  }
+  ParticleStore<D>& P() { return sim.particles(); }
+  // Drives a and b with these velocities and spins for `steps` steps.
+  void drive(const Vec<D>& va, const Vec<D>& vb, const Ang<D>& wa, const Ang<D>& wb, int steps) {
+    for (int s = 0; s < steps; ++s) {
+      P().vel[P().index(a)] = va, P().vel[P().index(b)] = vb;
+      P().spin[P().index(a)] = wa, P().spin[P().index(b)] = wb;
+      sim.step();
+    }
+  }
+  Vec<D> force() { return P().force[P().index(b)]; }
+  Ang<D> torque() { return P().torque[P().index(b)]; }
+  double kn() const { return kModulus / (2 * kR); }
+  double ks() const { return kn() / kRatio; }
+  BondSection<D> section(double lambda = 1.0) const { return BondSection<D>::of(lambda * kR, 1.0); }
+};
+
+TEST(BondStiffness, Normal3D) {
+  BondedPair<3> p(cement(1e12, 1e12));
+  const double v = 0.01;
+  p.drive(V3::Zero(), v * p.n, V3::Zero(), V3::Zero(), 100);  // 0.1 um apart
+  const double stretch = 100 * v * kDt;
+  EXPECT_NEAR(p.force().x(), -p.kn() * p.section().area * stretch, 1e-9 * p.force().norm());
+  EXPECT_NEAR(p.force().y(), 0.0, 1e-12);
+}
+
+TEST(BondStiffness, Shear3D) {
+  BondedPair<3> p(cement(1e12, 1e12));
+  const double v = 0.01;
+  p.drive(V3::Zero(), V3(0, v, 0), V3::Zero(), V3::Zero(), 100);
+  const double slide = 100 * v * kDt;  // 0.1 um, the normal turns by 5e-5 rad
+  EXPECT_NEAR(p.force().y(), -p.ks() * p.section().area * slide, 1e-3 * p.force().norm());
+}
+
+TEST(BondStiffness, BendingAndTwist3D) {
+  const double w = 10.0;  // rad/s each, opposite: a relative turn of 2 w t, no slip at the centre
+  {
+    BondedPair<3> p(cement(1e12, 1e12));
+    p.drive(V3::Zero(), V3::Zero(), V3(0, 0, -w), V3(0, 0, w), 100);
+    const double theta = 2 * w * 100 * kDt;
+    EXPECT_NEAR(p.torque().z(), -p.kn() * p.section().inertia * theta, 1e-9 * p.torque().norm());
+    EXPECT_LT(p.force().norm(), 1e-9 * p.torque().norm() / kR);
+  }
+  {
+    BondedPair<3> p(cement(1e12, 1e12));
+    p.drive(V3::Zero(), V3::Zero(), V3(-w, 0, 0), V3(w, 0, 0), 100);
+    const double theta = 2 * w * 100 * kDt;
+    EXPECT_NEAR(p.torque().x(), -p.ks() * p.section().polar * theta, 1e-9 * p.torque().norm());
+  }
+}
+
+TEST(BondStiffness, NormalShearBending2D) {
+  const double v = 0.01, w = 10.0;
+  {
+    BondedPair<2> p(cement(1e12, 1e12));
+    p.drive(V2::Zero(), V2(v, 0), 0.0, 0.0, 100);
+    const double area = 2 * kR * 1.0;  // unit thickness
+    EXPECT_NEAR(p.force().x(), -p.kn() * area * 100 * v * kDt, 1e-9 * p.force().norm());
+  }
+  {
+    BondedPair<2> p(cement(1e12, 1e12));
+    p.drive(V2::Zero(), V2(0, v), 0.0, 0.0, 100);
+    EXPECT_NEAR(p.force().y(), -p.ks() * 2 * kR * 100 * v * kDt, 1e-3 * p.force().norm());
+  }
+  {
+    BondedPair<2> p(cement(1e12, 1e12));
+    p.drive(V2::Zero(), V2::Zero(), -w, w, 100);
+    const double inertia = 2 * kR * kR * kR / 3;  // 2 R^3 t / 3
+    EXPECT_NEAR(p.torque(), -p.kn() * inertia * 2 * w * 100 * kDt, 1e-9 * std::abs(p.torque()));
+  }
+}
+
+// Loads a bond at a steady rate until it breaks; checks the break came at the first step
+// whose stress reached the strength (so within one step's increment of it).
+template <int D, class Drive>
+void breaksAtStrength(const BondKind& kind, Drive drive, BondBreakMode mode, double strength,
+                      double increment_per_step) {
+  BondedPair<D> p(kind);
+  std::vector<BondBreak<D>> breaks;
+  int steps = 0;
+  while (breaks.empty() && steps < 100000) {
+    drive(p);
+    ++steps;
+    breaks = p.sim.takeBondBreaks();
+  }
+  ASSERT_EQ(breaks.size(), 1u);
+  EXPECT_EQ(breaks[0].mode, mode);
+  EXPECT_GE(breaks[0].stress, strength);
+  EXPECT_LT(breaks[0].stress, strength + 1.0001 * increment_per_step);
+  EXPECT_EQ(p.sim.bonds().size(), 0u);
+  EXPECT_EQ(p.sim.brokenBonds(0, mode), 1u);
+  // Broken: nothing holds the pair in tension any more.
+  drive(p);
+  EXPECT_EQ(p.force().norm(), 0.0);
+}
+
+TEST(BondBreaks, PureTension) {
+  const double strength = 8e6, v = 0.01;
+  BondedPair<3> probe(cement(strength, 1e12));
+  const double increment = probe.kn() * v * kDt;  // tensile stress per step
+  breaksAtStrength<3>(
+      cement(strength, 1e12),
+      [&](BondedPair<3>& p) { p.drive(V3::Zero(), v * p.n, V3::Zero(), V3::Zero(), 1); },
+      BondBreakMode::Tensile, strength, increment);
+}
+
+TEST(BondBreaks, PureShear) {
+  const double strength = 8e6, v = 0.01;
+  BondedPair<3> probe(cement(1e12, strength));
+  // |Fs| / A grows by ks v dt per step (the pair also turns a little: allow 1% more).
+  const double increment = 1.01 * probe.ks() * v * kDt;
+  breaksAtStrength<3>(
+      cement(1e12, strength),
+      [&](BondedPair<3>& p) { p.drive(V3::Zero(), V3(0, v, 0), V3::Zero(), V3::Zero(), 1); },
+      BondBreakMode::Shear, strength, increment);
+}
+
+TEST(BondBreaks, Bending) {
+  const double strength = 8e6, w = 10.0;
+  BondedPair<3> probe(cement(strength, 1e12));
+  const auto s = probe.section();
+  const double increment = probe.kn() * s.inertia * 2 * w * kDt * s.radius / s.inertia;
+  breaksAtStrength<3>(
+      cement(strength, 1e12),
+      [&](BondedPair<3>& p) { p.drive(V3::Zero(), V3::Zero(), V3(0, 0, -w), V3(0, 0, w), 1); },
+      BondBreakMode::Tensile, strength, increment);
+}
+
+TEST(BondBreaks, TwoDimensionalTension) {
+  const double strength = 8e6, v = 0.01;
+  BondedPair<2> probe(cement(strength, 1e12));
+  breaksAtStrength<2>(
+      cement(strength, 1e12), [&](BondedPair<2>& p) { p.drive(V2::Zero(), V2(v, 0), 0.0, 0.0, 1); },
+      BondBreakMode::Tensile, strength, probe.kn() * v * kDt);
+}
+
+TEST(BondBreaks, CompressionDoesNotBreakAndTheContactRemains) {
+  BondedPair<3> p(cement(1e3, 1e3));                               // weak
+  p.drive(V3::Zero(), -0.01 * p.n, V3::Zero(), V3::Zero(), 3000);  // 1 um into contact
+  EXPECT_EQ(p.sim.bonds().size(), 1u);
+  EXPECT_GT(
+      p.force().x(),
+      0.0);  // pushed back by bond and contact
+             // Pull apart past the gap the bond was made at: the weak bond breaks in tension, and
+  // nothing holds the pair any more.
+  p.drive(V3::Zero(), 0.01 * p.n, V3::Zero(), V3::Zero(), 5000);
+  EXPECT_EQ(p.sim.bonds().size(), 0u);
+  EXPECT_EQ(p.force().norm(), 0.0);
+  // And pushed together again, the frictional contact alone still carries compression.
+  p.drive(V3::Zero(), -0.01 * p.n, V3::Zero(), V3::Zero(), 5000);
+  EXPECT_GT(p.force().x(), 0.0);
+}
+
+// Cementing a packing: strengths drawn from normal(8, 8) MPa; draws <= 0 handled as set.
+TEST(Cementing, StrengthDrawsAndNegativeHandling) {
+  // A simple cubic lattice of touching spheres: 3 x 14 x 15^2 = 9450 candidate pairs.
+  std::vector<V3> lattice;
+  for (int x = 0; x < 15; ++x) {
+    for (int y = 0; y < 15; ++y) {
+      for (int z = 0; z < 15; ++z) lattice.push_back(2 * kR * V3(x, y, z));
+    }
+  }
+  for (NegativeStrength mode : {NegativeStrength::Skip, NegativeStrength::Resample}) {
+    SimulationConfig cfg;
+    Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), cfg);
+    for (const V3& x : lattice) testing::addParticle<3>(sim, x, kR, V3::Zero());
+    BondKind k = cement(8e6, 8e6);
+    k.tensile_std = k.shear_std = 8e6;
+    k.negative = mode;
+    const CementReport r = sim.cement(sim.addBondKind(k), 0.05);
+    ASSERT_EQ(r.candidates, 9450u);
+    EXPECT_EQ(r.installed + r.skipped_nonpositive, r.candidates);
+    const auto& B = sim.bonds();
+    double mean = 0;
+    for (double s : B.tensile) {
+      EXPECT_GT(s, 0.0);
+      mean += s / static_cast<double>(B.size());
+    }
+    // P(normal draw <= 0) = Phi(-1) = 0.1587 for each of the two strengths.
+    const double p0 = 0.158655;
+    if (mode == NegativeStrength::Skip) {
+      const double skipped = 1.0 - (1.0 - p0) * (1.0 - p0);
+      EXPECT_NEAR(static_cast<double>(r.skipped_nonpositive) / r.candidates, skipped, 0.015);
+      EXPECT_EQ(r.redrawn, 0u);
+    } else {
+      EXPECT_EQ(r.skipped_nonpositive, 0u);
+      EXPECT_NEAR(static_cast<double>(r.redrawn) / (2.0 * r.candidates), p0 / (1 - p0), 0.015);
+    }
+    // Mean of the kept draws: for the truncated normal 8 + 8 phi(1)/(1 - Phi(-1)) = 11.4 MPa.
+    EXPECT_NEAR(mean, 8e6 + 8e6 * 0.241971 / (1 - p0), 0.2e6);
+    // Bonds start unloaded.
+    for (const auto& l : B.load) EXPECT_EQ(l.fn, 0.0);
+  }
+}
+
+// A bonded pair whose order in the particle arrays flips (reordering at neighbour rebuilds)
+// keeps its load: compare with a run that never reorders.
+TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
+  auto run = [](bool reorder) {
+    SimulationConfig cfg;
+    cfg.timestep.automatic = false;
+    cfg.timestep.fixed_dt = kDt;
+    cfg.spatial_sort = reorder;
+    cfg.skin = reorder ? 2e-5 : 0.1;
+    Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), cfg);
+    ParticleSpec<3> p;
+    p.radius = kR;
+    p.fixed = true;
+    // The same geometry as the contact-history test: crossing a sort-cell boundary swaps
+    // the pair's order. The anchor pins the grid.
+    p.position = V3(0, 2.5e-3, 0);
+    const auto a = sim.particles().add(p);
+    p.position = V3(0, 2.5e-3, 0) + (2 * kR + kGap) * V3(1, -1, 0).normalized();
+    const auto b = sim.particles().add(p);
+    p.position = V3(-1e-2, -1e-2, -1e-2);
+    sim.particles().add(p);
+    sim.cement(sim.addBondKind(cement(1e12, 1e12)), 0.01);
+    auto& P = sim.particles();
+    auto drive = [&](const V3& va, const V3& vb, const V3& wb, int steps) {
+      for (int s = 0; s < steps; ++s) {
+        P.vel[P.index(a)] = va, P.vel[P.index(b)] = vb, P.spin[P.index(b)] = wb;
+        sim.step();
+      }
+    };
+    drive(V3::Zero(), V3(0.01, 0.01, 0.0), V3(1, 2, 3), 100);  // load in every mode
+    const bool before = P.index(a) < P.index(b);
+
+    drive(V3(0, 10, 0), V3(0, 10, 0), V3::Zero(), 1000);  // +1 mm in y
+    drive(V3(10, 0, 0), V3(10, 0, 0), V3::Zero(), 800);   // +0.8 mm in x
+
+    EXPECT_EQ(reorder, before != (P.index(a) < P.index(b)));
+    return std::pair{V3(P.force[P.index(b)]), V3(P.torque[P.index(b)])};
+  };
+  const auto [f0, t0] = run(false);
+  const auto [f1, t1] = run(true);
+  ASSERT_GT(f0.norm(), 0.0);
+  EXPECT_LT((f1 - f0).norm(), 1e-9 * f0.norm());
+  EXPECT_LT((t1 - t0).norm(), 1e-9 * t0.norm());
+}
+
+TEST(Bonds, KindsAreValidated) {
+  BondKind k = cement(8e6, 8e6);
+  k.modulus = -1;
+  Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), SimulationConfig{});
+  EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
+  k = cement(-1e6, 8e6);
+  k.negative = NegativeStrength::Resample;
+  EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
+}
+
+}  // namespace
+}  // namespace rocklab
