@@ -1,0 +1,313 @@
+#include "lab/notebook/notebook.hpp"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <ctime>
+#include <tuple>
+
+namespace rocklab::notebook {
+
+namespace {
+
+constexpr std::size_t kBatchRows = 20000;
+
+double monotonicSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string hostName() {
+  char buf[256] = {};
+  if (gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+
+// FNV-1a, as text: the protocol's fingerprint.
+std::string hashText(std::string_view s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char out[17];
+  std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
+  return out;
+}
+
+}  // namespace
+
+std::string utcNow() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+std::string_view toString(RunStatus s) {
+  switch (s) {
+    case RunStatus::Running:
+      return "running";
+    case RunStatus::Completed:
+      return "completed";
+    case RunStatus::Failed:
+      return "failed";
+    case RunStatus::Interrupted:
+      return "interrupted";
+  }
+  return "failed";
+}
+
+const std::vector<std::string_view>& Notebook::migrations() {
+  static const std::vector<std::string_view> m = {
+      // 0 -> 1: runs and what they record.
+      R"sql(
+CREATE TABLE runs (
+  id INTEGER PRIMARY KEY,
+  protocol TEXT NOT NULL,
+  protocol_file TEXT NOT NULL,
+  protocol_text TEXT NOT NULL,
+  protocol_hash TEXT NOT NULL,
+  rig TEXT NOT NULL,
+  status TEXT NOT NULL CHECK (status IN ('running', 'completed', 'failed', 'interrupted')),
+  reason TEXT,
+  started TEXT NOT NULL,
+  finished TEXT,
+  wall_seconds REAL,
+  code_version TEXT NOT NULL,
+  build_type TEXT NOT NULL,
+  seed INTEGER,
+  threads INTEGER,
+  host TEXT NOT NULL,
+  pid INTEGER NOT NULL
+);
+CREATE TABLE params (
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  key TEXT NOT NULL,
+  value TEXT NOT NULL,
+  unit TEXT NOT NULL DEFAULT '',
+  PRIMARY KEY (run_id, key)
+);
+CREATE TABLE series (
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  name TEXT NOT NULL,
+  step INTEGER NOT NULL,
+  time_s REAL NOT NULL,
+  value REAL
+);
+CREATE INDEX series_by_run ON series (run_id, name, step);
+CREATE TABLE events (
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  step INTEGER NOT NULL,
+  time_s REAL NOT NULL,
+  kind TEXT NOT NULL,
+  mode TEXT,
+  x REAL, y REAL, z REAL,
+  particle_a INTEGER,
+  particle_b INTEGER,
+  granular TEXT,
+  value REAL
+);
+CREATE INDEX events_by_run ON events (run_id, kind, step);
+CREATE TABLE stage_timings (
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  stage TEXT NOT NULL,
+  seconds REAL NOT NULL,
+  calls INTEGER NOT NULL,
+  PRIMARY KEY (run_id, stage)
+);
+CREATE TABLE results (
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  name TEXT NOT NULL,
+  value REAL,
+  unit TEXT NOT NULL DEFAULT '',
+  PRIMARY KEY (run_id, name)
+);
+)sql",
+      // 1 -> 2: warnings and notes a run makes (e.g. a test that was not quasi-static).
+      R"sql(
+CREATE TABLE messages (
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  step INTEGER NOT NULL,
+  time_s REAL NOT NULL,
+  level TEXT NOT NULL CHECK (level IN ('info', 'warning')),
+  text TEXT NOT NULL
+);
+CREATE INDEX messages_by_run ON messages (run_id, step);
+)sql",
+  };
+  return m;
+}
+
+Notebook::Notebook(const std::string& path) : db_(std::make_unique<Connection>(path, true)) {
+  db_->exec("PRAGMA journal_mode = WAL");
+  db_->exec("PRAGMA foreign_keys = ON");
+  db_->exec("PRAGMA synchronous = NORMAL");
+  migrate(kSchemaVersion);
+  closeOrphanRuns();
+}
+
+void Notebook::createAtVersion(const std::string& path, int version) {
+  Connection c(path, true);
+  for (int v = 0; v < version; ++v) {
+    c.exec(migrations()[v]);
+    c.exec("PRAGMA user_version = " + std::to_string(v + 1));
+  }
+}
+
+void Notebook::migrate(int to) {
+  const int from = db_->userVersion();
+  if (from > to) {
+    throw SqlError("lab notebook '" + path() + "' has schema version " + std::to_string(from) +
+                   ", newer than this rocklab knows (" + std::to_string(to) +
+                   "): use a newer rocklab");
+  }
+  for (int v = from; v < to; ++v) {
+    Transaction t(*db_);
+    db_->exec(migrations()[v]);
+    db_->exec("PRAGMA user_version = " + std::to_string(v + 1));
+    t.commit();
+  }
+}
+
+void Notebook::closeOrphanRuns() {
+  const std::string host = hostName();
+  std::vector<std::int64_t> orphans;
+  {
+    auto s = db_->prepare("SELECT id, pid FROM runs WHERE status = 'running' AND host = ?");
+    s.bind(1, host);
+    while (s.step()) {
+      const auto pid = static_cast<pid_t>(s.integer(1));
+      if (kill(pid, 0) != 0 && errno == ESRCH) orphans.push_back(s.integer(0));
+    }
+  }
+  for (std::int64_t id : orphans) {
+    auto u = db_->prepare(
+        "UPDATE runs SET status = 'failed', reason = 'the process ended without closing the run "
+        "(killed or crashed); data up to its last batch are kept' WHERE id = ?");
+    u.bind(1, id).run();
+  }
+}
+
+RunWriter::RunWriter(Notebook& nb, const RunInfo& info, const std::vector<ParamRow>& params)
+    : nb_(nb), started_(monotonicSeconds()) {
+  Connection& db = nb_.db();
+  Transaction t(db);
+  auto s = db.prepare(
+      "INSERT INTO runs (protocol, protocol_file, protocol_text, protocol_hash, rig, status, "
+      "started, code_version, build_type, seed, threads, host, pid) "
+      "VALUES (?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?)");
+  s.bind(1, info.protocol).bind(2, info.protocol_file).bind(3, info.protocol_text);
+  s.bind(4, hashText(info.protocol_text)).bind(5, info.rig).bind(6, utcNow());
+  s.bind(7, info.code_version).bind(8, info.build_type).bind(9, info.seed);
+  s.bind(10, info.threads).bind(11, hostName()).bind(12, static_cast<std::int64_t>(getpid()));
+  s.run();
+  id_ = db.lastInsertId();
+  auto p = db.prepare("INSERT INTO params (run_id, key, value, unit) VALUES (?, ?, ?, ?)");
+  for (const ParamRow& r : params)
+    p.bind(1, id_).bind(2, r.key).bind(3, r.value).bind(4, r.unit).run();
+  t.commit();
+}
+
+RunWriter::~RunWriter() {
+  if (finished_) return;
+  try {
+    finish(RunStatus::Failed, "the run ended without being closed");
+  } catch (...) {
+  }
+}
+
+void RunWriter::series(std::string_view name, std::uint64_t step, double time, double value) {
+  series_.push_back({std::string(name), step, time, value});
+  if (series_.size() + events_.size() >= kBatchRows) flush();
+}
+
+void RunWriter::event(const EventRow& e) {
+  events_.push_back(e);
+  if (series_.size() + events_.size() >= kBatchRows) flush();
+}
+
+void RunWriter::message(std::uint64_t step, double time, std::string_view level,
+                        std::string_view text) {
+  messages_.push_back({step, time, std::string(level), std::string(text)});
+}
+
+void RunWriter::result(std::string_view name, double value, std::string_view unit) {
+  results_.push_back({std::string(name), value, std::string(unit)});
+}
+
+void RunWriter::stageTiming(std::string_view stage, double seconds, std::uint64_t calls) {
+  timings_.emplace_back(std::string(stage), seconds, calls);
+}
+
+void RunWriter::flush() {
+  if (series_.empty() && events_.empty() && messages_.empty() && results_.empty() &&
+      timings_.empty()) {
+    return;
+  }
+  Connection& db = nb_.db();
+  Transaction t(db);
+  {
+    auto s =
+        db.prepare("INSERT INTO series (run_id, name, step, time_s, value) VALUES (?, ?, ?, ?, ?)");
+    for (const Series& r : series_) {
+      s.bind(1, id_).bind(2, r.name).bind(3, r.step).bind(4, r.time).bind(5, r.value).run();
+    }
+  }
+  {
+    auto s = db.prepare(
+        "INSERT INTO events (run_id, step, time_s, kind, mode, x, y, z, particle_a, particle_b, "
+        "granular, value) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    for (const EventRow& e : events_) {
+      s.bind(1, id_).bind(2, e.step).bind(3, e.time).bind(4, e.kind).bind(5, e.mode);
+      s.bind(6, e.x).bind(7, e.y).bind(8, e.z).bind(9, e.particle_a).bind(10, e.particle_b);
+      s.bind(11, e.granular).bind(12, e.value).run();
+    }
+  }
+  {
+    auto s = db.prepare(
+        "INSERT INTO messages (run_id, step, time_s, level, text) VALUES (?, ?, ?, ?, ?)");
+    for (const Message& m : messages_) {
+      s.bind(1, id_).bind(2, m.step).bind(3, m.time).bind(4, m.level).bind(5, m.text).run();
+    }
+  }
+  {
+    auto s = db.prepare(
+        "INSERT OR REPLACE INTO results (run_id, name, value, unit) VALUES (?, ?, ?, ?)");
+    for (const Result& r : results_) {
+      s.bind(1, id_).bind(2, r.name).bind(3, r.value).bind(4, r.unit).run();
+    }
+  }
+  {
+    auto s = db.prepare(
+        "INSERT OR REPLACE INTO stage_timings (run_id, stage, seconds, calls) VALUES (?, ?, ?, ?)");
+    for (const auto& [stage, seconds, calls] : timings_) {
+      s.bind(1, id_).bind(2, stage).bind(3, seconds).bind(4, calls).run();
+    }
+  }
+  t.commit();
+  series_.clear();
+  events_.clear();
+  messages_.clear();
+  results_.clear();
+  timings_.clear();
+}
+
+void RunWriter::finish(RunStatus status, std::string_view reason) {
+  if (finished_) return;
+  flush();
+  auto s = nb_.db().prepare(
+      "UPDATE runs SET status = ?, reason = ?, finished = ?, wall_seconds = ? WHERE id = ?");
+  s.bind(1, toString(status));
+  if (reason.empty()) {
+    s.bindNull(2);
+  } else {
+    s.bind(2, reason);
+  }
+  s.bind(3, utcNow()).bind(4, monotonicSeconds() - started_).bind(5, id_).run();
+  finished_ = true;
+}
+
+}  // namespace rocklab::notebook

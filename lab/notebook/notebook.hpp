@@ -1,0 +1,117 @@
+#pragma once
+// The lab notebook: one SQLite database per lab holding every run, its parameters, time
+// series, events, stage timings and key results. The schema (DESIGN.md; the user-facing
+// SQL interface is documented in the README) carries its version in PRAGMA user_version
+// and is migrated forward on open. WAL journal, foreign keys on, writes batched in
+// transactions.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lab/notebook/sqlite.hpp"
+
+namespace rocklab::notebook {
+
+inline constexpr int kSchemaVersion = 2;
+
+// Opens a lab notebook, creating it if needed, and brings its schema up to date. Runs a
+// previous process left `running` on this host and that process is gone are marked failed.
+class Notebook {
+ public:
+  explicit Notebook(const std::string& path);
+  Connection& db() { return *db_; }
+  const std::string& path() const { return db_->path(); }
+  // The schema migrations, in order; [k] takes version k to k + 1.
+  static const std::vector<std::string_view>& migrations();
+  // For tests: open a database and migrate it only up to `version`.
+  static void createAtVersion(const std::string& path, int version);
+
+ private:
+  void migrate(int to);
+  void closeOrphanRuns();
+  std::unique_ptr<Connection> db_;
+};
+
+enum class RunStatus { Running, Completed, Failed, Interrupted };
+std::string_view toString(RunStatus s);
+
+struct RunInfo {
+  std::string protocol;       // protocol name
+  std::string protocol_file;  // path it was read from
+  std::string protocol_text;  // the whole file
+  std::string rig;
+  std::string code_version;  // git revision
+  std::string build_type;
+  std::int64_t seed = 0;
+  int threads = 1;
+};
+
+struct ParamRow {
+  std::string key, value, unit;
+};
+
+struct EventRow {
+  std::uint64_t step = 0;
+  double time = 0.0;
+  std::string kind;  // e.g. bond_break
+  std::string mode;  // e.g. tensile, shear
+  double x = 0.0, y = 0.0, z = 0.0;
+  std::int64_t particle_a = -1, particle_b = -1;
+  std::string granular;  // inter or intra
+  double value = 0.0;    // e.g. the stress that broke the bond (Pa)
+};
+
+// Records one run. Rows are buffered and written in batched transactions (flush() or
+// automatically past a batch size); finish() writes the rest and closes the run with its
+// status. A writer destroyed without finish() marks the run failed.
+class RunWriter {
+ public:
+  RunWriter(Notebook& nb, const RunInfo& info, const std::vector<ParamRow>& params);
+  ~RunWriter();
+  RunWriter(const RunWriter&) = delete;
+  RunWriter& operator=(const RunWriter&) = delete;
+
+  std::int64_t id() const { return id_; }
+  void series(std::string_view name, std::uint64_t step, double time, double value);
+  void event(const EventRow& e);
+  void message(std::uint64_t step, double time, std::string_view level, std::string_view text);
+  void result(std::string_view name, double value, std::string_view unit);
+  void stageTiming(std::string_view stage, double seconds, std::uint64_t calls);
+  void flush();
+  void finish(RunStatus status, std::string_view reason = {});
+
+ private:
+  struct Series {
+    std::string name;
+    std::uint64_t step;
+    double time, value;
+  };
+  struct Message {
+    std::uint64_t step;
+    double time;
+    std::string level, text;
+  };
+  Notebook& nb_;
+  std::int64_t id_ = 0;
+  std::vector<Series> series_;
+  std::vector<EventRow> events_;
+  std::vector<Message> messages_;
+  struct Result {
+    std::string name;
+    double value;
+    std::string unit;
+  };
+  std::vector<Result> results_;
+  std::vector<std::tuple<std::string, double, std::uint64_t>> timings_;
+  double started_ = 0.0;
+  bool finished_ = false;
+};
+
+// Current UTC time as ISO 8601 text.
+std::string utcNow();
+
+}  // namespace rocklab::notebook

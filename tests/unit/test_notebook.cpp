@@ -1,0 +1,176 @@
+// The lab notebook: schema and migrations, batched writing, run status on every ending,
+// queries and CSV.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <sstream>
+
+#include "lab/notebook/queries.hpp"
+
+namespace rocklab::notebook {
+namespace {
+
+class NotebookTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = (std::filesystem::temp_directory_path() /
+             ("rocklab-nb-" + std::to_string(::getpid()) + "-" +
+              ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".sqlite"))
+                .string();
+    std::filesystem::remove(path_);
+  }
+  void TearDown() override {
+    for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(path_ + ext);
+  }
+  RunInfo info() {
+    RunInfo i;
+    i.protocol = "oedometer-quick";
+    i.protocol_file = "protocols/oedometer-quick.toml";
+    i.protocol_text = "[protocol]\nname = \"oedometer-quick\"\n";
+    i.rig = "oedometer";
+    i.code_version = "abc123";
+    i.build_type = "Release";
+    i.seed = 7;
+    return i;
+  }
+  std::string scalar(Notebook& nb, const std::string& sql) {
+    const Table t = query(nb, sql);
+    return t.rows.empty() ? "" : t.rows[0][0].str();
+  }
+  std::string path_;
+};
+
+TEST_F(NotebookTest, NewNotebookHasTheSchemaWalAndForeignKeys) {
+  Notebook nb(path_);
+  EXPECT_EQ(nb.db().userVersion(), kSchemaVersion);
+  EXPECT_EQ(scalar(nb, "PRAGMA journal_mode"), "wal");
+  EXPECT_EQ(scalar(nb, "PRAGMA foreign_keys"), "1");
+  for (const char* t :
+       {"runs", "params", "series", "events", "stage_timings", "results", "messages"}) {
+    EXPECT_EQ(
+        scalar(nb, std::string("SELECT count(*) FROM sqlite_master WHERE name = '") + t + "'"), "1")
+        << t;
+  }
+}
+
+TEST_F(NotebookTest, RecordsARunAndClosesIt) {
+  Notebook nb(path_);
+  std::int64_t id;
+  {
+    RunWriter w(nb, info(), {{"loading.axial_strain_rate_per_s", "0.5", "1/s"}});
+    id = w.id();
+    EXPECT_EQ(scalar(nb, "SELECT status FROM runs WHERE id = " + std::to_string(id)), "running");
+    for (int k = 0; k < 10; ++k) w.series("axial_stress_MPa", k * 100, k * 1e-3, 2.0 * k);
+    EventRow e;
+    e.kind = "bond_break";
+    e.mode = "tensile";
+    e.x = 1e-3;
+    e.granular = "inter";
+    w.event(e);
+    w.result("broken_bonds_total", 1, "");
+    w.stageTiming("contacts", 1.5, 1000);
+    w.message(5, 0.1, "warning", "not quasi-static");
+    w.finish(RunStatus::Completed);
+  }
+  const std::string where = " WHERE run_id = " + std::to_string(id);
+  EXPECT_EQ(scalar(nb, "SELECT status FROM runs WHERE id = " + std::to_string(id)), "completed");
+  EXPECT_EQ(scalar(nb, "SELECT count(*) FROM series" + where), "10");
+  EXPECT_EQ(scalar(nb, "SELECT value FROM series" + where + " AND step = 900"), "18");
+  EXPECT_EQ(scalar(nb, "SELECT mode FROM events" + where), "tensile");
+  EXPECT_EQ(scalar(nb, "SELECT unit FROM params" + where), "1/s");
+  EXPECT_EQ(scalar(nb, "SELECT value FROM results" + where), "1");
+  EXPECT_EQ(scalar(nb, "SELECT calls FROM stage_timings" + where), "1000");
+  EXPECT_EQ(scalar(nb, "SELECT level FROM messages" + where), "warning");
+  EXPECT_NE(scalar(nb, "SELECT protocol_hash FROM runs"), "");
+  EXPECT_NE(scalar(nb, "SELECT finished FROM runs"), "");
+  // Deleting a run takes its records with it (foreign keys).
+  nb.db().exec("DELETE FROM runs");
+  EXPECT_EQ(scalar(nb, "SELECT count(*) FROM series"), "0");
+}
+
+TEST_F(NotebookTest, AWriterLeftOpenMarksTheRunFailedAndKeepsItsData) {
+  Notebook nb(path_);
+  {
+    RunWriter w(nb, info(), {});
+    w.series("x", 1, 0.0, 1.0);
+  }  // as when an exception unwinds the run
+  EXPECT_EQ(scalar(nb, "SELECT status FROM runs"), "failed");
+  EXPECT_NE(scalar(nb, "SELECT reason FROM runs"), "");
+  EXPECT_EQ(scalar(nb, "SELECT count(*) FROM series"), "1");
+}
+
+TEST_F(NotebookTest, InterruptedRunsSayWhy) {
+  Notebook nb(path_);
+  RunWriter w(nb, info(), {});
+  w.finish(RunStatus::Interrupted, "SIGTERM received");
+  EXPECT_EQ(scalar(nb, "SELECT status || ': ' || reason FROM runs"),
+            "interrupted: SIGTERM received");
+}
+
+TEST_F(NotebookTest, LargeRunsAreWrittenInBatchesWhileRunning) {
+  Notebook nb(path_);
+  RunWriter w(nb, info(), {});
+  for (int k = 0; k < 50000; ++k) w.series("s", k, k, k);
+  // A second connection, as another process would, already sees the committed batches.
+  Notebook other(path_);
+  EXPECT_EQ(scalar(other, "SELECT count(*) FROM series"), "40000");
+  w.finish(RunStatus::Completed);
+  EXPECT_EQ(scalar(other, "SELECT count(*) FROM series"), "50000");
+}
+
+TEST_F(NotebookTest, OldSchemaIsMigratedAndNewerRefused) {
+  Notebook::createAtVersion(path_, 1);
+  {
+    Connection c(path_, false);
+    c.exec(
+        "INSERT INTO runs (protocol, protocol_file, protocol_text, protocol_hash, rig, status, "
+        "started, code_version, build_type, host, pid) VALUES ('p', 'f', 't', 'h', 'oedometer', "
+        "'completed', 'now', 'v', 'Release', 'h', 1)");
+  }
+  {
+    Notebook nb(path_);
+    EXPECT_EQ(nb.db().userVersion(), 2);
+    EXPECT_EQ(scalar(nb, "SELECT protocol FROM runs"), "p");
+    EXPECT_EQ(scalar(nb, "SELECT count(*) FROM messages"), "0");
+  }
+  {
+    Connection c(path_, false);
+    c.exec("PRAGMA user_version = 99");
+  }
+  try {
+    Notebook nb(path_);
+    FAIL();
+  } catch (const SqlError& e) {
+    EXPECT_NE(std::string(e.what()).find("newer"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(NotebookTest, RunsOfDeadProcessesAreMarkedFailedOnOpen) {
+  {
+    Notebook nb(path_);
+    char host[256] = {};
+    gethostname(host, sizeof host - 1);
+    auto s = nb.db().prepare(
+        "INSERT INTO runs (protocol, protocol_file, protocol_text, protocol_hash, rig, status, "
+        "started, code_version, build_type, host, pid) VALUES ('p', 'f', 't', 'h', 'oedometer', "
+        "'running', 'now', 'v', 'Release', ?, 2147483646)");
+    s.bind(1, std::string(host)).run();
+  }
+  Notebook nb(path_);
+  EXPECT_EQ(scalar(nb, "SELECT status FROM runs"), "failed");
+}
+
+TEST_F(NotebookTest, TablesPrintAlignedAndAsCsv) {
+  Notebook nb(path_);
+  Table t = query(nb, "SELECT 1 AS a, 'x, \"y\"' AS b, 2.5 AS c, NULL AS d");
+  std::ostringstream csv, text;
+  printTable(csv, t, true);
+  printTable(text, t, false);
+  EXPECT_EQ(csv.str(), "a,b,c,d\n1,\"x, \"\"y\"\"\",2.5,\n");
+  EXPECT_NE(text.str().find("a  b"), std::string::npos) << text.str();
+  EXPECT_THROW(showRun(nb, 42), SqlError);
+}
+
+}  // namespace
+}  // namespace rocklab::notebook
