@@ -1,0 +1,367 @@
+#include "lab/protocol/params.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <toml.hpp>
+
+namespace rocklab::protocol {
+
+namespace {
+
+using TomlValue = toml::basic_value<toml::discard_comments, std::map, std::vector>;
+
+std::string number(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+std::string show(const Value& v) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return number(x);
+        } else if constexpr (std::is_same_v<T, std::int64_t>) {
+          return std::to_string(x);
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return x;
+        } else if constexpr (std::is_same_v<T, bool>) {
+          return x ? "true" : "false";
+        } else {
+          std::string s = "[";
+          for (std::size_t k = 0; k < x.size(); ++k) s += (k ? ", " : "") + number(x[k]);
+          return s + "]";
+        }
+      },
+      v);
+}
+
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+bool inRange(const ParamDecl& d, double v) {
+  const bool lo = d.lo_open ? v > d.lo : v >= d.lo;
+  const bool hi = d.hi_open ? v < d.hi : v <= d.hi;
+  return lo && hi && v == v;
+}
+
+std::string unitText(const ParamDecl& d) {
+  return d.unit.empty() ? "" : " (" + d.unit + ")";
+}
+
+}  // namespace
+
+std::string ParamDecl::rangeText() const {
+  if (kind == Kind::Choice) {
+    std::string s = "one of: ";
+    for (std::size_t k = 0; k < choices.size(); ++k) s += (k ? ", " : "") + choices[k];
+    return s;
+  }
+  if (kind == Kind::Text || kind == Kind::Flag) return "";
+  return std::string(lo_open ? "(" : "[") + number(lo) + ", " + number(hi) + (hi_open ? ")" : "]");
+}
+
+ParamDecl& Schema::add(ParamDecl d) {
+  if (find(d.key)) throw std::logic_error("parameter declared twice: " + d.key);
+  decls_.push_back(std::move(d));
+  return decls_.back();
+}
+
+ParamDecl& Schema::real(const std::string& key, const std::string& unit, double to_si,
+                        std::optional<double> fallback, const std::string& doc) {
+  ParamDecl d;
+  d.key = key, d.kind = Kind::Real, d.unit = unit, d.to_si = to_si, d.doc = doc;
+  if (fallback) d.fallback = *fallback;
+  return add(std::move(d));
+}
+
+ParamDecl& Schema::integer(const std::string& key, std::optional<std::int64_t> fallback,
+                           const std::string& doc) {
+  ParamDecl d;
+  d.key = key, d.kind = Kind::Integer, d.unit = "-", d.doc = doc;
+  if (fallback) d.fallback = *fallback;
+  return add(std::move(d));
+}
+
+ParamDecl& Schema::text(const std::string& key, std::optional<std::string> fallback,
+                        const std::string& doc) {
+  ParamDecl d;
+  d.key = key, d.kind = Kind::Text, d.doc = doc;
+  if (fallback) d.fallback = *fallback;
+  return add(std::move(d));
+}
+
+ParamDecl& Schema::choice(const std::string& key, std::vector<std::string> choices,
+                          std::optional<std::string> fallback, const std::string& doc) {
+  ParamDecl d;
+  d.key = key, d.kind = Kind::Choice, d.choices = std::move(choices), d.doc = doc;
+  if (fallback) d.fallback = *fallback;
+  return add(std::move(d));
+}
+
+ParamDecl& Schema::flag(const std::string& key, std::optional<bool> fallback,
+                        const std::string& doc) {
+  ParamDecl d;
+  d.key = key, d.kind = Kind::Flag, d.doc = doc;
+  if (fallback) d.fallback = *fallback;
+  return add(std::move(d));
+}
+
+ParamDecl& Schema::realList(const std::string& key, const std::string& unit, double to_si,
+                            std::optional<std::vector<double>> fallback, const std::string& doc) {
+  ParamDecl d;
+  d.key = key, d.kind = Kind::RealList, d.unit = unit, d.to_si = to_si, d.doc = doc;
+  if (fallback) d.fallback = *fallback;
+  return add(std::move(d));
+}
+
+const ParamDecl* Schema::find(const std::string& key) const {
+  for (const ParamDecl& d : decls_) {
+    if (d.key == key) return &d;
+  }
+  return nullptr;
+}
+
+std::string Schema::help() const {
+  std::ostringstream s;
+  for (const ParamDecl& d : decls_) {
+    s << "  " << d.key << unitText(d);
+    if (d.fallback) {
+      s << " = " << show(*d.fallback);
+    } else {
+      s << "  (required)";
+    }
+    const std::string r = d.rangeText();
+    if (!r.empty()) s << "  " << r;
+    s << "\n      " << d.doc << "\n";
+  }
+  return s.str();
+}
+
+ProtocolError::ProtocolError(const std::vector<std::string>& problems)
+    : std::runtime_error([&] {
+        std::string s;
+        for (const auto& p : problems) s += (s.empty() ? "" : "\n") + p;
+        return s;
+      }()),
+      problems_(problems) {}
+
+const ParamDecl& Settings::decl(const std::string& key) const {
+  const ParamDecl* d = schema_ ? schema_->find(key) : nullptr;
+  if (!d) throw std::logic_error("protocol key not declared: " + key);
+  return *d;
+}
+
+const Value& Settings::value(const std::string& key) const {
+  decl(key);
+  return values_.at(key);
+}
+
+double Settings::real(const std::string& key) const {
+  return std::get<double>(value(key));
+}
+double Settings::si(const std::string& key) const {
+  return real(key) * decl(key).to_si;
+}
+std::int64_t Settings::integer(const std::string& key) const {
+  return std::get<std::int64_t>(value(key));
+}
+const std::string& Settings::text(const std::string& key) const {
+  return std::get<std::string>(value(key));
+}
+bool Settings::flag(const std::string& key) const {
+  return std::get<bool>(value(key));
+}
+std::vector<double> Settings::list(const std::string& key) const {
+  return std::get<std::vector<double>>(value(key));
+}
+std::vector<double> Settings::listSi(const std::string& key) const {
+  std::vector<double> v = list(key);
+  for (double& x : v) x *= decl(key).to_si;
+  return v;
+}
+
+std::string Settings::where(const std::string& key) const {
+  auto it = given_.find(key);
+  return file_ + (it == given_.end() ? "" : ":" + std::to_string(it->second));
+}
+
+std::vector<ParamRow> Settings::table() const {
+  std::vector<ParamRow> rows;
+  for (const ParamDecl& d : schema_->all())
+    rows.push_back({d.key, show(values_.at(d.key)), d.unit});
+  return rows;
+}
+
+void fail(const Settings& s, const std::string& key, const std::string& why) {
+  throw ProtocolError({s.where(key) + ": " + key + ": " + why});
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ProtocolError({path + ": cannot read the protocol file"});
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+namespace {
+
+TomlValue parseToml(const std::string& file, const std::string& text) {
+  std::istringstream in(text);
+  try {
+    return toml::parse<toml::discard_comments, std::map, std::vector>(in, file);
+  } catch (const std::exception& e) {
+    throw ProtocolError({file + ": not valid TOML:\n" + e.what()});
+  }
+}
+
+}  // namespace
+
+std::string rigOf(const std::string& file, const std::string& text) {
+  const TomlValue root = parseToml(file, text);
+  if (!root.contains("protocol") || !root.at("protocol").is_table() ||
+      !root.at("protocol").contains("rig") || !root.at("protocol").at("rig").is_string()) {
+    throw ProtocolError({file + ": missing key 'protocol.rig' (text): the rig that runs the "
+                                "protocol, e.g. rig = \"oedometer\""});
+  }
+  return root.at("protocol").at("rig").as_string().str;
+}
+
+Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema) {
+  const TomlValue root = parseToml(file, text);
+  Settings s;
+  s.schema_ = &schema;
+  s.file_ = file;
+  s.source_ = text;
+  std::vector<std::pair<int, std::string>> problems;
+  auto problem = [&](int line, const std::string& what) {
+    problems.emplace_back(line, file + ":" + std::to_string(line) + ": " + what);
+  };
+
+  auto walk = [&](auto&& self, const TomlValue& table, const std::string& prefix) -> void {
+    for (const auto& [k, v] : table.as_table()) {
+      const std::string key = prefix.empty() ? k : prefix + "." + k;
+      const int line = static_cast<int>(v.location().line());
+      if (v.is_table()) {
+        self(self, v, key);
+        continue;
+      }
+      const ParamDecl* d = schema.find(key);
+      if (!d) {
+        std::string best;
+        std::size_t best_d = 4;
+        for (const ParamDecl& c : schema.all()) {
+          const std::size_t e = editDistance(key, c.key);
+          if (e < best_d) best_d = e, best = c.key;
+        }
+        problem(line, "unknown key '" + key + "'" +
+                          (best.empty() ? "" : "; did you mean '" + best + "'?") +
+                          " (`rocklab check --keys FILE` lists the keys)");
+        continue;
+      }
+      s.given_[key] = line;
+      const std::string expect = "'" + key + "'" + unitText(*d) + " expects ";
+      auto checkRange = [&](double x) {
+        if (!inRange(*d, x)) {
+          problem(line, key + " = " + number(x) + " is outside the allowed range " +
+                            d->rangeText() + unitText(*d));
+        }
+      };
+      switch (d->kind) {
+        case Kind::Real:
+          if (!v.is_floating() && !v.is_integer()) {
+            problem(line, expect + "a number");
+            break;
+          }
+          s.values_[key] = v.is_floating() ? v.as_floating() : static_cast<double>(v.as_integer());
+          checkRange(std::get<double>(s.values_[key]));
+          break;
+        case Kind::Integer:
+          if (!v.is_integer()) {
+            problem(line, expect + "an integer");
+            break;
+          }
+          s.values_[key] = static_cast<std::int64_t>(v.as_integer());
+          checkRange(static_cast<double>(v.as_integer()));
+          break;
+        case Kind::Text:
+        case Kind::Choice:
+          if (!v.is_string()) {
+            problem(line, expect + "a string" +
+                              (d->kind == Kind::Choice ? " (" + d->rangeText() + ")" : ""));
+            break;
+          }
+          s.values_[key] = v.as_string().str;
+          if (d->kind == Kind::Choice && std::find(d->choices.begin(), d->choices.end(),
+                                                   v.as_string().str) == d->choices.end()) {
+            problem(line,
+                    key + " = \"" + v.as_string().str + "\" is not allowed: " + d->rangeText());
+          }
+          break;
+        case Kind::Flag:
+          if (!v.is_boolean()) {
+            problem(line, expect + "true or false");
+            break;
+          }
+          s.values_[key] = v.as_boolean();
+          break;
+        case Kind::RealList: {
+          if (!v.is_array()) {
+            problem(line, expect + "a list of numbers, e.g. [0.01, 0.02]");
+            break;
+          }
+          std::vector<double> list;
+          bool ok = true;
+          for (const auto& e : v.as_array()) {
+            if (e.is_floating() || e.is_integer()) {
+              list.push_back(e.is_floating() ? e.as_floating()
+                                             : static_cast<double>(e.as_integer()));
+              checkRange(list.back());
+            } else {
+              ok = false;
+            }
+          }
+          if (!ok) problem(line, expect + "a list of numbers only");
+          s.values_[key] = list;
+          break;
+        }
+      }
+    }
+  };
+  walk(walk, root, "");
+
+  for (const ParamDecl& d : schema.all()) {
+    if (s.values_.count(d.key)) continue;
+    if (d.fallback) {
+      if (!s.given_.count(d.key)) s.values_[d.key] = *d.fallback;
+    } else if (!s.given_.count(d.key)) {
+      problems.emplace_back(
+          1 << 30, file + ": missing required key '" + d.key + "'" + unitText(d) + ": " + d.doc);
+    }
+  }
+  if (!problems.empty()) {
+    std::stable_sort(problems.begin(), problems.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<std::string> lines;
+    for (auto& p : problems) lines.push_back(std::move(p.second));
+    throw ProtocolError(lines);
+  }
+  return s;
+}
+
+}  // namespace rocklab::protocol
