@@ -7,6 +7,7 @@
 
 #include "lab/cli/bench.hpp"
 #include "lab/cli/build_info.hpp"
+#include "lab/cli/lab_commands.hpp"
 #include "lab/core/contact_laws.hpp"
 #include "lab/core/packing_io.hpp"
 
@@ -133,6 +134,54 @@ int main(int argc, char** argv) {
   b->add_option("--save-packing", bench.save_packing, "Write the generated packing to this file");
   b->add_flag("--json", json, "Print JSON");
   b->callback([&] { action = [&] { return runBenchCommand(bench, json); }; });
+
+  rocklab::cli::RunOptions run;
+  auto* r = app.add_subcommand("run", "Run a protocol; every measurement goes to the lab notebook");
+  r->add_option("protocol", run.protocol, "Protocol file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  r->add_option("--lab", run.lab, "Lab notebook (SQLite), created if missing");
+  r->add_flag("--quiet", run.quiet, "No progress on stderr");
+  r->add_option("--threads", run.threads, "Threads, instead of numerics.threads (same results)")
+      ->check(CLI::Range(1, 1024));
+  r->callback([&] { action = [&] { return rocklab::cli::runProtocol(run); }; });
+
+  std::string check_file;
+  auto* c = app.add_subcommand("check", "Validate a protocol without running it");
+  c->add_option("protocol", check_file, "Protocol file (TOML)")->required();
+  c->callback([&] { action = [&] { return rocklab::cli::checkProtocol(check_file); }; });
+
+  std::string keys_rig;
+  auto* k =
+      app.add_subcommand("keys", "List a rig's protocol keys with units, defaults and ranges");
+  k->add_option("rig", keys_rig, "oedometer, hydrostatic")->required();
+  k->callback([&] { action = [&] { return rocklab::cli::listKeys(keys_rig); }; });
+
+  rocklab::cli::NotebookOptions nbo;
+  auto* nbc = app.add_subcommand("notebook", "Query the lab notebook");
+  nbc->add_option("--lab", nbo.lab, "Lab notebook (SQLite)");
+  nbc->add_flag("--csv", nbo.csv, "Print CSV");
+  nbc->require_subcommand(1);
+  nbc->add_subcommand("runs", "List the runs")->callback([&] { nbo.what = "runs"; });
+  auto* show = nbc->add_subcommand("show", "A run: its row, parameters, results, timings");
+  show->add_option("run", nbo.run, "Run id")->required();
+  show->callback([&] { nbo.what = "show"; });
+  auto* ser = nbc->add_subcommand("series", "A run's time series (long form)");
+  ser->add_option("run", nbo.run, "Run id")->required();
+  ser->add_option("names", nbo.names, "Series names (all when none)");
+  ser->callback([&] { nbo.what = "series"; });
+  auto* ev = nbc->add_subcommand("events", "A run's events (bond breaks ...)");
+  ev->add_option("run", nbo.run, "Run id")->required();
+  ev->add_option("--kind", nbo.kind, "Only events of this kind");
+  ev->callback([&] { nbo.what = "events"; });
+  auto* sql = nbc->add_subcommand("sql", "Any SQL query");
+  sql->add_option("query", nbo.sql, "SQL")->required();
+  sql->callback([&] { nbo.what = "sql"; });
+  for (auto* sub : {show, ser, ev, sql, nbc->get_subcommand("runs")}) {
+    sub->add_option("--lab", nbo.lab, "Lab notebook (SQLite)");
+    sub->add_flag("--csv", nbo.csv, "Print CSV");
+  }
+  nbc->callback([&] { action = [&] { return rocklab::cli::notebookCommand(nbo); }; });
 
   int dim = 3;
   rocklab::PackingSpec spec;

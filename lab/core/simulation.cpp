@@ -135,6 +135,26 @@ void Simulation<D>::setFixedTimeStep(double dt) {
 }
 
 template <int D>
+void Simulation<D>::replaceMaterials(MaterialTable materials) {
+  if (materials.size() < materials_.size()) {
+    throw std::invalid_argument("replaceMaterials: the new table has fewer materials");
+  }
+  materials_ = std::move(materials);
+  model_.reset();
+  prepared_ = false;
+}
+
+template <int D>
+Simulation<D> Simulation<D>::clone() const {
+  ArchiveWriter w;
+  const_cast<Simulation*>(this)->visit(w);
+  Simulation copy(MaterialTable{}, SimulationConfig{});
+  ArchiveReader r(w.bytes().data(), w.bytes().size());
+  copy.visit(r);
+  return copy;
+}
+
+template <int D>
 void Simulation<D>::prepare() {
   const std::string where = "simulation settings";
   requireRange(where, "local_damping", config_.local_damping, 0.0, false, 1.0, true, "-");
@@ -200,7 +220,7 @@ void Simulation<D>::prepare() {
       dt_ = config_.timestep.fixed_dt;
     }
   }
-    prepared_ = true;
+  prepared_ = true;
   if (!ledger_.started) restartEnergyLedger();
 }
 
@@ -531,7 +551,7 @@ void Simulation<D>::rebuild() {
       for (std::size_t b = 0; b < bonds_.size(); ++b) {
         std::uint32_t a = new_index[bonds_.i[b]], c = new_index[bonds_.j[b]];
         if (a > c) {
-                    // Keep i < j: seen from the other particle, the shear force and bending moment on
+          // Keep i < j: seen from the other particle, the shear force and bending moment on
           // j change sign; the normal force and the twist (a moment about n, which flips
           // too) do not.
           std::swap(a, c);
@@ -787,7 +807,7 @@ double Simulation<D>::criticalTimeStep() const {
   // Bonds add their normal stiffness to translation, shear and bending to rotation.
   for (std::size_t b = 0; b < bonds_.size(); ++b) {
     const auto s = BondSection<D>::of(bonds_.radius[b], P.thickness);
-        const double kn = bonds_.kn[b] * s.area, ks = bonds_.ks[b] * s.area;
+    const double kn = bonds_.kn[b] * s.area, ks = bonds_.ks[b] * s.area;
     const double moment = bonds_.kn[b] * s.inertia + bonds_.ks[b] * s.polar;
     for (const std::uint32_t p : {bonds_.i[b], bonds_.j[b]}) {
       kt[p] += kn;

@@ -131,6 +131,12 @@ class Simulation {
   void setThreads(int threads);
   void setLocalDamping(double alpha) { config_.local_damping = alpha; }
   void setFixedTimeStep(double dt);
+  // Replaces the materials (e.g. the friction after forming a sample); contact history and
+  // bonds stay. The table must keep the indices particles and walls use.
+  void replaceMaterials(MaterialTable materials);
+  // A deep copy through the checkpoint serializer (a branch of an experiment, a wave
+  // measurement on a copy of a loaded sample); stage timings start anew.
+  Simulation clone() const;
   // Starts the energy ledger anew from the present state.
   void restartEnergyLedger();
   Rng& rng() { return rng_; }
@@ -150,6 +156,9 @@ class Simulation {
   std::vector<BondBreak<D>> takeBondBreaks() { return std::exchange(bond_breaks_, {}); }
 
   // --- running ---
+  // Validates the settings, builds the contact model and the neighbour list, evaluates the
+  // forces and sets the time step; step() does it on its first call.
+  void prepare();
   void step();
   void run(std::uint64_t steps);
 
@@ -181,7 +190,6 @@ class Simulation {
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };
 
-  void prepare();
   // Forces and torques at the present positions. With history_dt = 0 the contact history
   // does not advance (the set-up evaluation that velocity Verlet needs before its first
   // step); returns whether an overlap exceeded the guard's limit.

@@ -11,7 +11,10 @@ namespace rocklab::notebook {
 
 namespace {
 
+// A batch is written when it reaches this many rows or this age, so a run killed outright
+// loses at most a few seconds of records.
 constexpr std::size_t kBatchRows = 20000;
+constexpr double kBatchSeconds = 2.0;
 
 double monotonicSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -137,6 +140,10 @@ CREATE TABLE messages (
 );
 CREATE INDEX messages_by_run ON messages (run_id, step);
 )sql",
+      // 2 -> 3: the protocol stage an event happened in.
+      R"sql(
+ALTER TABLE events ADD COLUMN stage TEXT;
+)sql",
   };
   return m;
 }
@@ -192,7 +199,7 @@ void Notebook::closeOrphanRuns() {
 }
 
 RunWriter::RunWriter(Notebook& nb, const RunInfo& info, const std::vector<ParamRow>& params)
-    : nb_(nb), started_(monotonicSeconds()) {
+        : nb_(nb), started_(monotonicSeconds()), last_flush_(started_) {
   Connection& db = nb_.db();
   Transaction t(db);
   auto s = db.prepare(
@@ -219,14 +226,21 @@ RunWriter::~RunWriter() {
   }
 }
 
+void RunWriter::flushIfDue() {
+  if (series_.size() + events_.size() >= kBatchRows ||
+      monotonicSeconds() - last_flush_ > kBatchSeconds) {
+    flush();
+  }
+}
+
 void RunWriter::series(std::string_view name, std::uint64_t step, double time, double value) {
   series_.push_back({std::string(name), step, time, value});
-  if (series_.size() + events_.size() >= kBatchRows) flush();
+  flushIfDue();
 }
 
 void RunWriter::event(const EventRow& e) {
   events_.push_back(e);
-  if (series_.size() + events_.size() >= kBatchRows) flush();
+  flushIfDue();
 }
 
 void RunWriter::message(std::uint64_t step, double time, std::string_view level,
@@ -247,11 +261,11 @@ void RunWriter::flush() {
       timings_.empty()) {
     return;
   }
+    last_flush_ = monotonicSeconds();
   Connection& db = nb_.db();
   Transaction t(db);
   {
-    auto s =
-        db.prepare("INSERT INTO series (run_id, name, step, time_s, value) VALUES (?, ?, ?, ?, ?)");
+    auto s = db.prepare("INSERT INTO series (run_id, name, step, time_s, value) VALUES (?, ?, ?, ?, ?)");
     for (const Series& r : series_) {
       s.bind(1, id_).bind(2, r.name).bind(3, r.step).bind(4, r.time).bind(5, r.value).run();
     }
@@ -259,11 +273,11 @@ void RunWriter::flush() {
   {
     auto s = db.prepare(
         "INSERT INTO events (run_id, step, time_s, kind, mode, x, y, z, particle_a, particle_b, "
-        "granular, value) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        "granular, value, stage) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     for (const EventRow& e : events_) {
       s.bind(1, id_).bind(2, e.step).bind(3, e.time).bind(4, e.kind).bind(5, e.mode);
       s.bind(6, e.x).bind(7, e.y).bind(8, e.z).bind(9, e.particle_a).bind(10, e.particle_b);
-      s.bind(11, e.granular).bind(12, e.value).run();
+      s.bind(11, e.granular).bind(12, e.value).bind(13, e.stage).run();
     }
   }
   {

@@ -16,7 +16,7 @@
 
 namespace rocklab::notebook {
 
-inline constexpr int kSchemaVersion = 2;
+inline constexpr int kSchemaVersion = 3;
 
 // Opens a lab notebook, creating it if needed, and brings its schema up to date. Runs a
 // previous process left `running` on this host and that process is gone are marked failed.
@@ -57,8 +57,9 @@ struct ParamRow {
 struct EventRow {
   std::uint64_t step = 0;
   double time = 0.0;
-  std::string kind;  // e.g. bond_break
-  std::string mode;  // e.g. tensile, shear
+  std::string stage;  // the protocol stage, e.g. formation, loading, cored
+  std::string kind;   // e.g. bond_break
+  std::string mode;   // e.g. tensile, shear
   double x = 0.0, y = 0.0, z = 0.0;
   std::int64_t particle_a = -1, particle_b = -1;
   std::string granular;  // inter or intra
@@ -107,8 +108,10 @@ class RunWriter {
   };
   std::vector<Result> results_;
   std::vector<std::tuple<std::string, double, std::uint64_t>> timings_;
-  double started_ = 0.0;
+    double started_ = 0.0;
+  double last_flush_ = 0.0;
   bool finished_ = false;
+  void flushIfDue();
 };
 
 // Current UTC time as ISO 8601 text.

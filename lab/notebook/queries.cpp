@@ -85,8 +85,8 @@ Table seriesOf(Notebook& nb, std::int64_t run, const std::vector<std::string>& n
 Table eventsOf(Notebook& nb, std::int64_t run, const std::string& kind) {
   requireRun(nb, run);
   auto s = nb.db().prepare(
-      "SELECT step, time_s, kind, mode, x, y, z, particle_a, particle_b, granular, value FROM "
-      "events WHERE run_id = ? AND (? = '' OR kind = ?) ORDER BY step, rowid");
+      "SELECT step, time_s, stage, kind, mode, x, y, z, particle_a, particle_b, granular, value "
+      "FROM events WHERE run_id = ? AND (? = '' OR kind = ?) ORDER BY step, rowid");
   s.bind(1, run).bind(2, kind).bind(3, kind);
   Table t;
   for (int c = 0; c < s.columns(); ++c) t.columns.push_back(s.columnName(c));

@@ -207,6 +207,18 @@ std::vector<ParamRow> Settings::table() const {
   return rows;
 }
 
+void Settings::override(const std::string& key, Value v) {
+  const ParamDecl& d = decl(key);
+  if (std::holds_alternative<double>(v) && !inRange(d, std::get<double>(v))) {
+    throw ProtocolError({key + " = " + show(v) + " is outside the allowed range " + d.rangeText()});
+  }
+  if (std::holds_alternative<std::int64_t>(v) &&
+      !inRange(d, static_cast<double>(std::get<std::int64_t>(v)))) {
+    throw ProtocolError({key + " = " + show(v) + " is outside the allowed range " + d.rangeText()});
+  }
+  values_[key] = std::move(v);
+}
+
 void fail(const Settings& s, const std::string& key, const std::string& why) {
   throw ProtocolError({s.where(key) + ": " + key + ": " + why});
 }
@@ -245,7 +257,7 @@ std::string rigOf(const std::string& file, const std::string& text) {
 Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema) {
   const TomlValue root = parseToml(file, text);
   Settings s;
-  s.schema_ = &schema;
+  s.schema_ = std::make_shared<const Schema>(schema);
   s.file_ = file;
   s.source_ = text;
   std::vector<std::pair<int, std::string>> problems;
@@ -271,7 +283,7 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
         }
         problem(line, "unknown key '" + key + "'" +
                           (best.empty() ? "" : "; did you mean '" + best + "'?") +
-                          " (`rocklab check --keys FILE` lists the keys)");
+                          " (`rocklab keys RIG` lists them)");
         continue;
       }
       s.given_[key] = line;

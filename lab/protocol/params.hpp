@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -96,13 +97,15 @@ class Settings {
   // Every parameter with its value (given or default) and unit.
   std::vector<ParamRow> table() const;
   const std::string& file() const { return file_; }
+  // Replaces a value after parsing (a command-line override); the range is checked.
+  void override(const std::string& key, Value v);
   const std::string& source() const { return source_; }
 
  private:
   friend Settings parseProtocol(const std::string&, const std::string&, const Schema&);
   const Value& value(const std::string& key) const;
   const ParamDecl& decl(const std::string& key) const;
-  const Schema* schema_ = nullptr;
+  std::shared_ptr<const Schema> schema_;  // owned: settings outlive the schema they came from
   std::string file_, source_;
   std::map<std::string, Value> values_;
   std::map<std::string, int> given_;  // key -> line

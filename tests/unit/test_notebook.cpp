@@ -112,9 +112,10 @@ TEST_F(NotebookTest, LargeRunsAreWrittenInBatchesWhileRunning) {
   Notebook nb(path_);
   RunWriter w(nb, info(), {});
   for (int k = 0; k < 50000; ++k) w.series("s", k, k, k);
-  // A second connection, as another process would, already sees the committed batches.
+    // A second connection, as another process would, already sees the committed batches
+  // (every 20,000 rows; more if a batch also came of age, as under sanitizers).
   Notebook other(path_);
-  EXPECT_EQ(scalar(other, "SELECT count(*) FROM series"), "40000");
+  EXPECT_GE(std::stoi(scalar(other, "SELECT count(*) FROM series")), 40000);
   w.finish(RunStatus::Completed);
   EXPECT_EQ(scalar(other, "SELECT count(*) FROM series"), "50000");
 }
@@ -130,9 +131,10 @@ TEST_F(NotebookTest, OldSchemaIsMigratedAndNewerRefused) {
   }
   {
     Notebook nb(path_);
-    EXPECT_EQ(nb.db().userVersion(), 2);
+        EXPECT_EQ(nb.db().userVersion(), kSchemaVersion);
     EXPECT_EQ(scalar(nb, "SELECT protocol FROM runs"), "p");
-    EXPECT_EQ(scalar(nb, "SELECT count(*) FROM messages"), "0");
+        EXPECT_EQ(scalar(nb, "SELECT count(*) FROM messages"), "0");
+    EXPECT_EQ(scalar(nb, "SELECT count(*) FROM events WHERE stage IS NULL"), "0");
   }
   {
     Connection c(path_, false);

@@ -1,0 +1,180 @@
+#include "lab/cli/lab_commands.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <iostream>
+
+#include "lab/cli/build_info.hpp"
+#include "lab/core/simulation.hpp"
+#include "lab/notebook/queries.hpp"
+#include "rigs/registry.hpp"
+
+namespace rocklab::cli {
+
+namespace {
+
+std::atomic<int> g_signal{0};
+
+extern "C" void onSignal(int sig) {
+  g_signal.store(sig);
+}
+
+const char* interruption() {
+  switch (g_signal.load()) {
+    case 0:
+      return nullptr;
+    case SIGINT:
+      return "interrupted by the user (SIGINT)";
+    case SIGTERM:
+      return "terminated (SIGTERM)";
+    default:
+      return "stopped by a signal";
+  }
+}
+
+// The notebook behind the rigs' Recorder interface.
+class NotebookRecorder : public rigs::Recorder {
+ public:
+  explicit NotebookRecorder(notebook::RunWriter& w) : w_(w) {}
+  void series(std::string_view name, std::uint64_t step, double time, double value) override {
+    w_.series(name, step, time, value);
+  }
+  void event(const rigs::EventRecord& e) override {
+    notebook::EventRow r;
+    r.step = e.step, r.time = e.time, r.stage = e.stage, r.kind = e.kind, r.mode = e.mode;
+    r.x = e.x, r.y = e.y, r.z = e.z, r.particle_a = e.particle_a, r.particle_b = e.particle_b;
+    r.granular = e.granular, r.value = e.value;
+    w_.event(r);
+  }
+  void result(std::string_view name, double value, std::string_view unit) override {
+    w_.result(name, value, unit);
+  }
+  void message(std::uint64_t step, double time, std::string_view level,
+               std::string_view text) override {
+    if (level == "warning") std::cerr << "warning: " << text << "\n";
+    w_.message(step, time, level, text);
+  }
+  void stageTiming(std::string_view stage, double seconds, std::uint64_t calls) override {
+    w_.stageTiming(stage, seconds, calls);
+  }
+
+ private:
+  notebook::RunWriter& w_;
+};
+
+}  // namespace
+
+int checkProtocol(const std::string& path) {
+  try {
+    const auto c = rigs::checkProtocol(path);
+    std::size_t given = 0, total = 0;
+    for (const auto& row : c.settings.table()) {
+      ++total;
+      given += c.settings.given(row.key);
+    }
+    std::cout << path << ": a valid " << c.rig->name << " protocol (" << given << " keys set, "
+              << total - given << " defaults)\n";
+    return 0;
+  } catch (const protocol::ProtocolError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  }
+}
+
+int listKeys(const std::string& rig) {
+  try {
+    const auto& r = rigs::findRig(rig, "rocklab keys");
+    std::cout << "Keys of " << r.name << " protocols (" << r.doc << "):\n"
+              << rigs::schemaOf(r).help();
+    return 0;
+  } catch (const protocol::ProtocolError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  }
+}
+
+int runProtocol(const RunOptions& o) {
+  // Everything about the protocol is checked before the notebook is touched: an invalid
+  // protocol writes nothing.
+  rigs::CheckedProtocol c{nullptr, {}};
+  try {
+    c = rigs::checkProtocol(o.protocol);
+  } catch (const protocol::ProtocolError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  }
+  protocol::Settings settings = c.settings;
+  if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+
+  notebook::Notebook nb(o.lab);
+  notebook::RunInfo info;
+  info.protocol = settings.text("protocol.name");
+  info.protocol_file = std::filesystem::absolute(o.protocol).string();
+  info.protocol_text = settings.source();
+  info.rig = std::string(c.rig->name);
+  info.code_version = kGitRevision;
+  info.build_type = kBuildType;
+  info.seed = settings.integer("protocol.seed");
+  info.threads = static_cast<int>(settings.integer("numerics.threads"));
+  std::vector<notebook::ParamRow> params;
+  for (const auto& p : settings.table()) params.push_back({p.key, p.value, p.unit});
+  notebook::RunWriter writer(nb, info, params);
+  NotebookRecorder rec(writer);
+
+  g_signal.store(0);
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  rigs::RunControl control(!o.quiet && isatty(STDERR_FILENO), interruption);
+  std::cerr << "run " << writer.id() << ": " << info.protocol << " (" << info.rig << ") -> "
+            << o.lab << "\n";
+  int code = 0;
+  try {
+    c.rig->run(settings, rec, control);
+    control.done();
+    writer.finish(notebook::RunStatus::Completed);
+    std::cerr << "run " << writer.id() << " completed\n";
+  } catch (const rigs::Interrupted& e) {
+    control.done();
+    writer.finish(notebook::RunStatus::Interrupted, e.what());
+    std::cerr << "run " << writer.id() << " interrupted: " << e.what() << "\n";
+    code = 130;
+  } catch (const std::exception& e) {
+    control.done();
+    writer.finish(notebook::RunStatus::Failed, e.what());
+    std::cerr << "run " << writer.id() << " failed: " << e.what() << "\n";
+    code = 1;
+  }
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  return code;
+}
+
+int notebookCommand(const NotebookOptions& o) {
+  if (!std::filesystem::exists(o.lab)) {
+    std::cerr << "no lab notebook at '" << o.lab << "' (rocklab run creates it; --lab PATH)\n";
+    return 2;
+  }
+  notebook::Notebook nb(o.lab);
+  if (o.what == "runs") {
+    notebook::printTable(std::cout, notebook::listRuns(nb), o.csv);
+  } else if (o.what == "show") {
+    for (const auto& [title, table] : notebook::showRun(nb, o.run)) {
+      if (table.rows.empty() && title != "run") continue;
+      if (!o.csv) std::cout << "== " << title << "\n";
+      notebook::printTable(std::cout, table, o.csv);
+      if (!o.csv) std::cout << "\n";
+    }
+  } else if (o.what == "series") {
+    notebook::printTable(std::cout, notebook::seriesOf(nb, o.run, o.names), o.csv);
+  } else if (o.what == "events") {
+    notebook::printTable(std::cout, notebook::eventsOf(nb, o.run, o.kind), o.csv);
+  } else {
+    notebook::printTable(std::cout, notebook::query(nb, o.sql), o.csv);
+  }
+  return 0;
+}
+
+}  // namespace rocklab::cli

@@ -1,0 +1,61 @@
+#pragma once
+// What every rig needs around the simulation: a recorder for its measurements (the lab
+// notebook in `rocklab run`, memory in tests), progress and interruption.
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace rocklab::rigs {
+
+struct EventRecord {
+  std::uint64_t step = 0;
+  double time = 0.0;
+  std::string stage, kind, mode, granular;
+  double x = 0.0, y = 0.0, z = 0.0;
+  std::int64_t particle_a = -1, particle_b = -1;
+  double value = 0.0;
+};
+
+class Recorder {
+ public:
+  virtual ~Recorder() = default;
+  virtual void series(std::string_view name, std::uint64_t step, double time, double value) = 0;
+  virtual void event(const EventRecord& e) = 0;
+  virtual void result(std::string_view name, double value, std::string_view unit) = 0;
+  virtual void message(std::uint64_t step, double time, std::string_view level,
+                       std::string_view text) = 0;
+  virtual void stageTiming(std::string_view stage, double seconds, std::uint64_t calls) = 0;
+};
+
+// Raised when the user interrupts a run (Ctrl-C, SIGTERM); the run is closed as
+// `interrupted` with what it recorded until then.
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Progress on stderr (when it is a terminal and not quiet) and the interruption check.
+class RunControl {
+ public:
+  RunControl(bool show_progress, std::function<const char*()> interrupted)
+      : show_(show_progress), interrupted_(std::move(interrupted)) {}
+  // Throws Interrupted when a stop was requested; prints progress at most 4 times a second.
+  // `fraction` < 0 when the stage's length is not known in advance.
+  void tick(std::string_view stage, std::uint64_t steps, double fraction, std::string_view detail);
+  void done();  // ends the progress line
+
+ private:
+  bool show_;
+  std::function<const char*()> interrupted_;
+  std::chrono::steady_clock::time_point last_print_{};
+  std::chrono::steady_clock::time_point stage_start_{};
+  std::string stage_;
+  std::uint64_t stage_steps0_ = 0;
+  bool printed_ = false;
+};
+
+}  // namespace rocklab::rigs

@@ -1,0 +1,66 @@
+#pragma once
+// The loading frame: a box of rigid walls (4 in 2D, 6 in 3D) around the sample. Each axis
+// is fixed, strain-rate controlled, or servo-controlled to a stress (constant or ramp).
+// Stresses come from wall forces over the current face areas, strains from wall
+// positions, porosity from the box volume and the particle volumes. The frame only writes
+// wall velocities and servo targets and reads wall forces: a rig never touches particles.
+
+#include <array>
+
+#include "lab/core/simulation.hpp"
+
+namespace rocklab::rigs {
+
+template <int D>
+class LoadingFrame {
+ public:
+  enum class Mode { Fixed, StrainRate, Stress };
+  struct Axis {
+    Mode mode = Mode::Fixed;
+    double strain_rate = 0.0;  // 1/s, compression positive (StrainRate)
+    double stress = 0.0;       // Pa, compression positive, at the moment it is set (Stress)
+    double stress_rate = 0.0;  // Pa/s (Stress: a ramp)
+  };
+
+  // Adds the walls on the faces of [lo, hi]; wall 2a bounds axis a from below, 2a + 1 from
+  // above. `wall_material` is an index of the simulation's material table.
+  LoadingFrame(Simulation<D>& sim, const Vec<D>& lo, const Vec<D>& hi, std::uint16_t wall_material);
+  // Re-attaches to a copy of the simulation this frame drives (its walls at the same
+  // indices), keeping the frame's settings.
+  void attach(Simulation<D>& sim) { sim_ = &sim; }
+
+  void set(int axis, const Axis& a);
+  const Axis& axis(int a) const { return axes_[a]; }
+  // Servo gain (relaxation factor, 0..1] and speed cap (m/s) for stress-controlled axes.
+  void setServo(double alpha, double max_speed);
+
+  // Keeps areas and strain-rate velocities current, then advances one step.
+  void step();
+
+  Simulation<D>& sim() { return *sim_; }
+  const Simulation<D>& sim() const { return *sim_; }
+
+  double length(int axis) const;
+  double faceArea(int axis) const;
+  double stress(int axis) const;  // Pa, compression positive, mean of the axis's two walls
+  double meanStress() const;
+  // Strain since the last resetReference(), compression positive.
+  double strain(int axis) const;
+  double volumetricStrain() const;
+  void resetReference();
+  double volume() const;    // m^3 (2D: area times thickness)
+  double porosity() const;  // 1 - particle volume / box volume
+  // Largest relative miss of the stress targets over the stress-controlled axes.
+  double stressError() const;
+
+ private:
+  void apply();
+  Simulation<D>* sim_;
+  std::array<Axis, D> axes_{};
+  std::array<double, D> reference_{};
+  double solid_volume_ = 0.0;
+  double servo_alpha_ = 0.5;
+  double servo_max_speed_ = 0.0;
+};
+
+}  // namespace rocklab::rigs

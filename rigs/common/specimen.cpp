@@ -1,0 +1,460 @@
+#include "rigs/common/specimen.hpp"
+
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "lab/core/packing.hpp"
+
+namespace rocklab::rigs {
+
+using protocol::range;
+
+void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_names) {
+  s.text("protocol.name", std::nullopt, "name of the protocol, as it appears in the notebook");
+  s.choice("protocol.rig", rig_names, std::nullopt, "the rig that runs the protocol");
+  s.text("protocol.description", std::string(), "what the protocol is for");
+  range(s.integer("protocol.dimension", 3, "2 (disks) or 3 (spheres)"), 2, false, 3, false);
+  range(s.integer("protocol.seed", 1, "seed of the packing and the bond strengths"), 0, false, 9e15,
+        false);
+
+  range(s.integer("sample.count", std::nullopt, "number of particles"), 2, false, 5e7, false);
+  s.choice("sample.size_distribution", {"uniform", "normal", "phi"}, "phi",
+           "diameters uniform in [d_min, d_max], normal(d_mean, d_std), or Gaussian in "
+           "phi = -log2(d / 1 mm); normal and phi are truncated to [d_min, d_max]");
+  range(s.real("sample.d_min_mm", "mm", 1e-3, 0.5, "smallest diameter"), 0, true, 1e4, false);
+  range(s.real("sample.d_max_mm", "mm", 1e-3, 2.0, "largest diameter"), 0, true, 1e4, false);
+  range(s.real("sample.d_mean_mm", "mm", 1e-3, 1.0, "mean diameter (normal)"), 0, true, 1e4, false);
+  range(s.real("sample.d_std_mm", "mm", 1e-3, 0.2, "diameter standard deviation (normal)"), 0,
+        false, 1e4, false);
+  range(s.real("sample.phi_mean", "phi", 1, 0.0, "mean of phi (phi)"), -20, false, 20, false);
+  range(s.real("sample.phi_std", "phi", 1, 0.5, "standard deviation of phi (phi)"), 0, false, 10,
+        false);
+  range(s.real("sample.porosity_initial", "-", 1, 0.4,
+               "porosity the packing is generated at (radius expansion), before formation"),
+        0.05, false, 0.9, false);
+  range(s.real("sample.aspect_axial", "-", 1, 1.0,
+               "axial length over lateral length of the generated box"),
+        0.1, false, 10, false);
+  range(s.real("sample.thickness_m", "m", 1, 1.0, "disk thickness (2D)"), 0, true, 1e3, false);
+
+  s.choice("material.contact_law", {"linear", "hertz"}, "linear", "contact law between grains");
+  range(s.real("material.density_kg_per_m3", "kg/m^3", 1, 2650, "grain density"), 1, false, 1e5,
+        false);
+  range(s.real("material.contact_modulus_GPa", "GPa", 1e9, 4.0,
+               "linear: contact modulus E, kn = E A / L per contact (PFC 5 deformability)"),
+        0, true, 1e4, false);
+  range(s.real("material.stiffness_ratio", "-", 1, 1.0, "linear: kn / ks of the contacts"), 0, true,
+        100, false);
+  range(s.real("material.young_GPa", "GPa", 1e9, 70.0, "hertz: Young's modulus of the grains"), 0,
+        true, 1e4, false);
+  range(s.real("material.poisson", "-", 1, 0.25, "hertz: Poisson's ratio of the grains"), -1, true,
+        0.5, false);
+  range(s.real("material.friction", "-", 1, 0.5, "grain-grain Coulomb friction after formation"), 0,
+        false, 10, false);
+  range(s.real("material.damping_ratio", "-", 1, 0.0, "critical damping ratio of contact dashpots"),
+        0, false, 1, true);
+  range(s.real("material.wall_friction", "-", 1, 0.0, "grain-wall friction"), 0, false, 10, false);
+
+  s.flag("bonds.enabled", true, "cement the sample after formation (parallel bonds)");
+  range(s.real("bonds.modulus_GPa", "GPa", 1e9, 4.0,
+               "bond modulus E, normal stiffness per area kn = E / L (L = r1 + r2)"),
+        0, true, 1e4, false);
+  range(s.real("bonds.stiffness_ratio", "-", 1, 0.5, "kn / ks of the bonds"), 0, true, 100, false);
+  range(s.real("bonds.radius_multiplier", "-", 1, 1.0, "bond radius over the smaller grain radius"),
+        0, true, 10, false);
+  range(s.real("bonds.tensile_strength_mean_MPa", "MPa", 1e6, 8.0, "mean tensile strength"), -1e4,
+        false, 1e4, false);
+  range(s.real("bonds.tensile_strength_std_MPa", "MPa", 1e6, 8.0, "tensile strength std"), 0, false,
+        1e4, false);
+  range(s.real("bonds.shear_strength_mean_MPa", "MPa", 1e6, 8.0, "mean shear strength"), -1e4,
+        false, 1e4, false);
+  range(s.real("bonds.shear_strength_std_MPa", "MPa", 1e6, 8.0, "shear strength std"), 0, false,
+        1e4, false);
+  s.choice("bonds.negative_strength", {"skip", "resample"}, "skip",
+           "a strength drawn <= 0: skip (no bond: it would break unloaded) or resample");
+  range(s.real("bonds.gap_ratio", "-", 1, 0.01,
+               "pairs closer than this times the smaller radius are cemented too"),
+        0, false, 1, false);
+
+  range(s.real("formation.axial_stress_MPa", "MPa", 1e6, 30.0, "axial stress of formation"), 0,
+        true, 1e4, false);
+  range(s.real("formation.lateral_stress_MPa", "MPa", 1e6, 15.0, "lateral stress of formation"), 0,
+        true, 1e4, false);
+  range(s.real("formation.friction", "-", 1, 0.0,
+               "grain friction while the sample is densified (isotropically, at the lateral "
+               "formation stress); low friction packs densely"),
+        0, false, 10, false);
+  range(s.real("formation.stress_tolerance", "-", 1, 0.01,
+               "settled when every wall is within this fraction of its target"),
+        1e-6, false, 0.5, false);
+  range(s.real("formation.unbalanced_force_ratio", "-", 1, 0.01,
+               "and the mean unbalanced force is below this fraction of the mean contact force"),
+        1e-7, false, 1, false);
+  range(s.integer("formation.max_steps", 2000000, "give up settling after this many steps"), 100,
+        false, 1e10, false);
+
+  range(s.real("numerics.timestep_safety", "-", 1, 0.5, "time step over the critical estimate"), 0,
+        true, 1, false);
+  range(s.real("numerics.local_damping", "-", 1, 0.7, "PFC local damping coefficient"), 0, false, 1,
+        true);
+  range(s.integer("numerics.threads", 1, "OpenMP threads; results do not depend on it"), 1, false,
+        1024, false);
+    range(s.real("numerics.skin_ratio", "-", 1, 0.2, "Verlet skin over the mean radius"), 0, true,
+        10, false);
+  range(s.real("numerics.overlap_limit", "-", 1, 0.25,
+               "the run stops when an overlap exceeds this fraction of the smaller radius"),
+        0, true, 1, false);
+  range(s.real("numerics.servo_alpha", "-", 1, 0.5,
+               "servo: fraction of the stress error closed "
+               "per step"),
+        0, true, 1, false);
+  range(s.real("numerics.servo_speed_radii_per_step", "-", 1, 1e-3,
+               "servo: largest wall move per step, in mean radii"),
+        0, true, 1, false);
+  range(s.real("numerics.quasi_static_unbalanced", "-", 1, 0.02,
+               "warn when the mean unbalanced force ratio of a loading stage exceeds this"),
+        0, true, 10, false);
+  range(s.real("numerics.quasi_static_inertial", "-", 1, 1e-3,
+               "warn when the inertial number of a loading stage exceeds this"),
+        0, true, 10, false);
+
+  range(s.integer("output.record_every_steps", 500, "steps between recorded measurements"), 1,
+        false, 1e9, false);
+}
+
+void validateCommon(const Settings& s) {
+  if (s.real("sample.d_max_mm") < s.real("sample.d_min_mm")) {
+    protocol::fail(s, "sample.d_max_mm", "must not be below sample.d_min_mm");
+  }
+  const std::string dist = s.text("sample.size_distribution");
+  const double dmin = s.real("sample.d_min_mm"), dmax = s.real("sample.d_max_mm");
+  if (dist == "normal" &&
+      (s.real("sample.d_mean_mm") < dmin || s.real("sample.d_mean_mm") > dmax)) {
+    protocol::fail(s, "sample.d_mean_mm", "must lie in [d_min_mm, d_max_mm]");
+  }
+  if (dist == "phi") {
+    const double d = std::exp2(-s.real("sample.phi_mean"));
+    if (d < dmin || d > dmax) {
+      protocol::fail(s, "sample.phi_mean",
+                     "the mean diameter 2^-phi_mean mm must lie in [d_min_mm, d_max_mm]");
+    }
+  }
+  if (s.text("bonds.negative_strength") == "resample" &&
+      (s.real("bonds.tensile_strength_mean_MPa") <= 0 ||
+       s.real("bonds.shear_strength_mean_MPa") <= 0)) {
+    protocol::fail(s, "bonds.negative_strength",
+                   "resample needs positive mean strengths (it draws until positive)");
+  }
+}
+
+namespace {
+
+SizeDistribution sizes(const Settings& s) {
+  const std::string d = s.text("sample.size_distribution");
+  const double lo = s.si("sample.d_min_mm"), hi = s.si("sample.d_max_mm");
+  if (d == "uniform") return SizeDistribution::uniform(lo, hi);
+  if (d == "normal") {
+    return SizeDistribution::normal(s.si("sample.d_mean_mm"), s.si("sample.d_std_mm"), lo, hi);
+  }
+  return SizeDistribution::phiGaussian(s.real("sample.phi_mean"), s.real("sample.phi_std"), lo, hi);
+}
+
+Material grainMaterial(const Settings& s, double friction) {
+  Material m;
+  m.name = "grain";
+  m.density = s.real("material.density_kg_per_m3");
+  m.modulus = s.si("material.contact_modulus_GPa");
+  m.stiffness_ratio = s.real("material.stiffness_ratio");
+  m.young = s.si("material.young_GPa");
+  m.poisson = s.real("material.poisson");
+  m.friction = friction;
+  m.damping_ratio = s.real("material.damping_ratio");
+  return m;
+}
+
+MaterialTable materials(const Settings& s, double friction) {
+  MaterialTable t;
+  t.add(grainMaterial(s, friction));
+  Material wall = grainMaterial(s, s.real("material.wall_friction"));
+  wall.name = "wall";
+  t.add(wall);
+  return t;
+}
+
+std::string fmt(double v, int precision = 3) {
+  std::ostringstream o;
+  o.precision(precision);
+  o << v;
+  return o.str();
+}
+
+// Runs the frame until the stresses hold and the sample is in equilibrium.
+template <int D>
+std::uint64_t settle(Specimen<D>& sp, const Settings& s, const std::string& stage, Recorder& rec,
+                     RunControl& control) {
+  auto& sim = *sp.sim;
+  const double tol = s.real("formation.stress_tolerance");
+  const double ub = s.real("formation.unbalanced_force_ratio");
+  const auto max_steps = static_cast<std::uint64_t>(s.integer("formation.max_steps"));
+  const std::uint64_t start = sim.steps();
+  for (;;) {
+    sp.frame->step();
+    const std::uint64_t done = sim.steps() - start;
+    if (done % sp.record_every == 0) recordState(sp, rec, stage + ".", stage, 0.0);
+    if (done % 100 != 0) continue;
+    const double err = sp.frame->stressError(), u = sim.unbalancedForceRatio();
+    control.tick(stage, sim.steps(), -1.0,
+                 "stress error " + fmt(err) + ", unbalanced force ratio " + fmt(u));
+    if (err < tol && u < ub) return done;
+    if (done >= max_steps) {
+      std::ostringstream why;
+      why << stage << " did not settle in " << done << " steps: the wall stresses miss their "
+          << "targets by " << fmt(err) << " (formation.stress_tolerance " << tol
+          << "), the unbalanced force ratio is " << fmt(u) << " (formation.unbalanced_force_ratio "
+          << ub << "); raise formation.max_steps or loosen the tolerances";
+      throw std::runtime_error(why.str());
+    }
+  }
+}
+
+}  // namespace
+
+template <int D>
+Specimen<D> Specimen<D>::branch() const {
+  Specimen<D> b;
+  b.sim = std::make_unique<Simulation<D>>(sim->clone());
+  b.frame = std::make_unique<LoadingFrame<D>>(*frame);
+  b.frame->attach(*b.sim);
+  b.mean_radius = mean_radius;
+  b.density = density;
+  b.cement_kind = cement_kind;
+  b.cement = cement;
+  b.record_every = record_every;
+  b.broken_offset[0] = broken_offset[0];
+  b.broken_offset[1] = broken_offset[1];
+  return b;
+}
+
+template <int D>
+std::uint64_t Specimen<D>::broken(BondBreakMode mode) const {
+  if (sim->bondKinds().empty()) return 0;
+  return sim->brokenBonds(cement_kind, mode) - broken_offset[mode == BondBreakMode::Shear];
+}
+
+template <int D>
+void Specimen<D>::resetBrokenCount() {
+  if (sim->bondKinds().empty()) return;
+  broken_offset[0] = sim->brokenBonds(cement_kind, BondBreakMode::Tensile);
+  broken_offset[1] = sim->brokenBonds(cement_kind, BondBreakMode::Shear);
+}
+
+template <int D>
+Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
+  control.tick("packing", 0, -1.0, "random placement and radius expansion");
+  PackingSpec spec;
+  spec.count = static_cast<std::size_t>(s.integer("sample.count"));
+  spec.sizes = sizes(s);
+  spec.porosity = s.real("sample.porosity_initial");
+  spec.aspect = {1.0, 1.0, 1.0};
+  spec.aspect[D - 1] = s.real("sample.aspect_axial");
+  spec.thickness = s.real("sample.thickness_m");
+  spec.seed = static_cast<std::uint64_t>(s.integer("protocol.seed"));
+  spec.threads = static_cast<int>(s.integer("numerics.threads"));
+  const Packing<D> p = generatePacking<D>(spec);
+
+  Specimen<D> sp;
+  sp.mean_radius =
+      std::accumulate(p.radii.begin(), p.radii.end(), 0.0) / static_cast<double>(p.radii.size());
+  sp.density = s.real("material.density_kg_per_m3");
+  sp.record_every = static_cast<std::uint64_t>(s.integer("output.record_every_steps"));
+  SimulationConfig cfg;
+  cfg.contact_law = s.text("material.contact_law");
+  cfg.skin = s.real("numerics.skin_ratio") * sp.mean_radius;
+  cfg.local_damping = s.real("numerics.local_damping");
+    cfg.timestep.safety = s.real("numerics.timestep_safety");
+  cfg.guard.overlap_limit = s.real("numerics.overlap_limit");
+  cfg.threads = spec.threads;
+  cfg.track_energy = true;
+  sp.sim = std::make_unique<Simulation<D>>(materials(s, s.real("formation.friction")), cfg);
+  sp.sim->particles().thickness = spec.thickness;
+  sp.sim->rng().reseed(spec.seed ^ 0x5eedb0d5ull);  // the bond strengths' own stream
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    ParticleSpec<D> ps;
+    ps.position = p.centers[i];
+    ps.radius = p.radii[i];
+    ps.density = sp.density;
+    sp.sim->particles().add(ps);
+  }
+  sp.frame = std::make_unique<LoadingFrame<D>>(*sp.sim, p.lo, p.hi, 1);
+  sp.sim->prepare();
+  sp.frame->setServo(s.real("numerics.servo_alpha"),
+                     s.real("numerics.servo_speed_radii_per_step") * sp.mean_radius / sp.sim->dt());
+  return sp;
+}
+
+template <int D>
+void formAndCement(Specimen<D>& sp, const Settings& s, Recorder& rec, RunControl& control) {
+  using Axis = typename LoadingFrame<D>::Axis;
+  using Mode = typename LoadingFrame<D>::Mode;
+  const double axial = s.si("formation.axial_stress_MPa");
+  const double lateral = s.si("formation.lateral_stress_MPa");
+  auto& sim = *sp.sim;
+  // Densify isotropically at the lateral stress with the formation friction (a dense
+  // packing), then with the grains' own friction take the formation state: a deviatoric
+  // stress the low friction could not hold.
+  for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, lateral, 0.0});
+  std::uint64_t steps = settle(sp, s, "densification", rec, control);
+  sim.replaceMaterials(materials(s, s.real("material.friction")));
+  for (int a = 0; a < D; ++a) {
+    sp.frame->set(a, Axis{Mode::Stress, 0.0, a == Specimen<D>::kAxial ? axial : lateral, 0.0});
+  }
+  steps += settle(sp, s, "formation", rec, control);
+  rec.result("formation_steps", static_cast<double>(steps), "");
+  rec.result("porosity_after_formation", sp.frame->porosity(), "");
+  rec.result("coordination_after_formation", sim.coordinationNumber(), "");
+  rec.result("axial_stress_after_formation_MPa", sp.frame->stress(Specimen<D>::kAxial) / 1e6,
+             "MPa");
+
+  if (s.flag("bonds.enabled")) {
+    BondKind k;
+    k.name = "cement";
+    k.modulus = s.si("bonds.modulus_GPa");
+    k.stiffness_ratio = s.real("bonds.stiffness_ratio");
+    k.radius_multiplier = s.real("bonds.radius_multiplier");
+    k.tensile_mean = s.si("bonds.tensile_strength_mean_MPa");
+    k.tensile_std = s.si("bonds.tensile_strength_std_MPa");
+    k.shear_mean = s.si("bonds.shear_strength_mean_MPa");
+    k.shear_std = s.si("bonds.shear_strength_std_MPa");
+    k.negative = s.text("bonds.negative_strength") == "resample" ? NegativeStrength::Resample
+                                                                 : NegativeStrength::Skip;
+    sp.cement_kind = sim.addBondKind(k);
+    sp.cement = sim.cement(sp.cement_kind, s.real("bonds.gap_ratio"));
+    rec.result("bonds_installed", static_cast<double>(sp.cement.installed), "");
+    rec.result("bonds_skipped_nonpositive", static_cast<double>(sp.cement.skipped_nonpositive), "");
+    rec.result("bonds_redrawn", static_cast<double>(sp.cement.redrawn), "");
+    rec.result("cement_candidates", static_cast<double>(sp.cement.candidates), "");
+    rec.message(sim.steps(), sim.time(), "info",
+                "cemented " + std::to_string(sp.cement.installed) + " of " +
+                    std::to_string(sp.cement.candidates) + " contacts; " +
+                    std::to_string(sp.cement.skipped_nonpositive) +
+                    " strength draws <= 0 left uncemented (bonds.negative_strength = " +
+                    s.text("bonds.negative_strength") + ")");
+  }
+  sim.restartEnergyLedger();
+  sp.frame->resetReference();
+  sp.resetBrokenCount();
+}
+
+template <int D>
+void servoTo(Specimen<D>& sp, const Settings& s, double axial, double lateral, double rate,
+             const std::string& stage, Recorder& rec, RunControl& control) {
+  using Axis = typename LoadingFrame<D>::Axis;
+  using Mode = typename LoadingFrame<D>::Mode;
+  auto& sim = *sp.sim;
+  constexpr int ax = Specimen<D>::kAxial;
+  std::array<double, D> from, to;
+  double span = 0.0;
+  for (int a = 0; a < D; ++a) {
+    from[a] = sp.frame->stress(a);
+    to[a] = a == ax ? axial : lateral;
+    span = std::max(span, std::abs(to[a] - from[a]));
+  }
+  const double duration = span / rate;
+  for (int a = 0; a < D; ++a) {
+    sp.frame->set(a, Axis{Mode::Stress, 0.0, from[a], (to[a] - from[a]) / duration});
+  }
+  const double t0 = sim.time();
+  while (sim.time() - t0 < duration) {
+    sp.frame->step();
+    if (sim.steps() % sp.record_every == 0) recordState(sp, rec, stage + ".", stage, 0.0);
+    if (sim.steps() % 100 == 0) {
+      control.tick(stage, sim.steps(), (sim.time() - t0) / duration,
+                   "axial " + fmt(sp.frame->stress(ax) / 1e6) + " MPa");
+    }
+  }
+  for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, to[a], 0.0});
+  settle(sp, s, stage, rec, control);
+}
+
+template <int D>
+double inertialNumber(const Specimen<D>& sp, double strain_rate) {
+  const double p = std::abs(sp.frame->meanStress());
+  if (!(p > 0.0)) return INFINITY;
+  return std::abs(strain_rate) * 2.0 * sp.mean_radius * std::sqrt(sp.density / p);
+}
+
+template <int D>
+void recordBreaks(Specimen<D>& sp, Recorder& rec, const std::string& stage) {
+  const auto& kinds = sp.sim->bondKinds();
+  for (const BondBreak<D>& b : sp.sim->takeBondBreaks()) {
+    EventRecord e;
+    e.step = b.step;
+    e.time = b.time;
+    e.stage = stage;
+    e.kind = "bond_break";
+    e.mode = b.mode == BondBreakMode::Tensile ? "tensile" : "shear";
+    e.granular = kinds[b.kind].intragranular ? "intra" : "inter";
+    e.x = b.position[0];
+    e.y = b.position[1];
+    if constexpr (D == 3) e.z = b.position[2];
+    e.particle_a = b.a.slot;
+    e.particle_b = b.b.slot;
+    e.value = b.stress;
+    rec.event(e);
+  }
+}
+
+template <int D>
+void recordState(Specimen<D>& sp, Recorder& rec, const std::string& prefix,
+                 const std::string& stage, double strain_rate) {
+  auto& sim = *sp.sim;
+  auto& f = *sp.frame;
+  constexpr int ax = Specimen<D>::kAxial;
+  const std::uint64_t step = sim.steps();
+  const double t = sim.time();
+  auto put = [&](const std::string& name, double v) { rec.series(prefix + name, step, t, v); };
+  double lateral = 0.0;
+  for (int a = 0; a < D; ++a) {
+    if (a != ax) lateral += f.stress(a) / (D - 1);
+  }
+  put("axial_stress_MPa", f.stress(ax) / 1e6);
+  put("lateral_stress_MPa", lateral / 1e6);
+  if constexpr (D == 3) {
+    put("lateral_stress_x_MPa", f.stress(0) / 1e6);
+    put("lateral_stress_y_MPa", f.stress(1) / 1e6);
+  }
+  put("axial_strain", f.strain(ax));
+  put("volumetric_strain", f.volumetricStrain());
+  put("porosity", f.porosity());
+  put("coordination_number", sim.coordinationNumber());
+  const double tensile = static_cast<double>(sp.broken(BondBreakMode::Tensile));
+  const double shear = static_cast<double>(sp.broken(BondBreakMode::Shear));
+  put("broken_bonds_tensile", tensile);
+  put("broken_bonds_shear", shear);
+  put("broken_bonds_total", tensile + shear);
+  put("unbalanced_force_ratio", sim.unbalancedForceRatio());
+  if (strain_rate != 0.0) put("inertial_number", inertialNumber(sp, strain_rate));
+  recordBreaks(sp, rec, stage);
+}
+
+template struct Specimen<2>;
+template struct Specimen<3>;
+template Specimen<2> buildSpecimen<2>(const Settings&, RunControl&);
+template Specimen<3> buildSpecimen<3>(const Settings&, RunControl&);
+template void formAndCement<2>(Specimen<2>&, const Settings&, Recorder&, RunControl&);
+template void formAndCement<3>(Specimen<3>&, const Settings&, Recorder&, RunControl&);
+template void servoTo<2>(Specimen<2>&, const Settings&, double, double, double, const std::string&,
+                         Recorder&, RunControl&);
+template void servoTo<3>(Specimen<3>&, const Settings&, double, double, double, const std::string&,
+                         Recorder&, RunControl&);
+template void recordState<2>(Specimen<2>&, Recorder&, const std::string&, const std::string&,
+                             double);
+template void recordState<3>(Specimen<3>&, Recorder&, const std::string&, const std::string&,
+                             double);
+template void recordBreaks<2>(Specimen<2>&, Recorder&, const std::string&);
+template void recordBreaks<3>(Specimen<3>&, Recorder&, const std::string&);
+template double inertialNumber<2>(const Specimen<2>&, double);
+template double inertialNumber<3>(const Specimen<3>&, double);
+
+}  // namespace rocklab::rigs

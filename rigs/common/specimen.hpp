@@ -1,0 +1,72 @@
+#pragma once
+// A specimen in a loading frame, built from a protocol: the packing, the material, the
+// frame; formation under stress and cementing; and the measurements every rig records.
+// The protocol sections shared by the rigs (protocol, sample, material, bonds,
+// formation, numerics, output) are declared here once.
+
+#include <memory>
+#include <string>
+
+#include "lab/protocol/params.hpp"
+#include "rigs/common/experiment.hpp"
+#include "rigs/common/frame.hpp"
+
+namespace rocklab::rigs {
+
+using protocol::Settings;
+
+// Declares the shared sections. `rig_names` are the allowed values of protocol.rig.
+void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_names);
+// Checks across keys of the shared sections (throws protocol::ProtocolError).
+void validateCommon(const Settings& s);
+
+template <int D>
+struct Specimen {
+  std::unique_ptr<Simulation<D>> sim;
+  std::unique_ptr<LoadingFrame<D>> frame;
+  double mean_radius = 0.0;  // m
+  double density = 0.0;      // kg/m^3
+  std::uint8_t cement_kind = 0;
+  CementReport cement;
+  std::uint64_t record_every = 500;
+  // Bonds broken before the measured stage (formation, coring) are not counted in it.
+  std::uint64_t broken_offset[2] = {0, 0};
+
+  static constexpr int kAxial = D - 1;  // z in 3D, y in 2D
+  // A deep copy for a branch of the experiment (e.g. virgin and cored).
+  Specimen branch() const;
+  std::uint64_t broken(BondBreakMode mode) const;
+  void resetBrokenCount();
+};
+
+// Generates the packing, builds the simulation with the protocol's material (friction
+// from formation.friction) and the frame at the packing's box.
+template <int D>
+Specimen<D> buildSpecimen(const Settings& s, RunControl& control);
+
+// Servo-controls the frame to the formation state (axial and lateral stress), settles it to
+// equilibrium, then sets the material's own friction and, when bonds are enabled, cements
+// every contact with zero initial load (the sample is "formed under stress").
+template <int D>
+void formAndCement(Specimen<D>& sp, const Settings& s, Recorder& rec, RunControl& control);
+
+// Moves the frame by servo from its present stresses to (axial, lateral) targets at a
+// stress rate, and holds there until settled. Used by coring and reloading.
+template <int D>
+void servoTo(Specimen<D>& sp, const Settings& s, double axial, double lateral, double rate,
+             const std::string& stage, Recorder& rec, RunControl& control);
+
+// Records the standard measurements as series `prefix + name` and hands over bond breaks
+// as events of `stage`.
+template <int D>
+void recordState(Specimen<D>& sp, Recorder& rec, const std::string& prefix,
+                 const std::string& stage, double strain_rate);
+template <int D>
+void recordBreaks(Specimen<D>& sp, Recorder& rec, const std::string& stage);
+
+// The inertial number I = edot d sqrt(rho / p) of the present loading: below about 1e-3 a
+// granular test is quasi-static (GDR MiDi 2004; da Cruz et al. 2005).
+template <int D>
+double inertialNumber(const Specimen<D>& sp, double strain_rate);
+
+}  // namespace rocklab::rigs

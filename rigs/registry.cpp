@@ -1,0 +1,48 @@
+#include "rigs/registry.hpp"
+
+#include "rigs/common/specimen.hpp"
+#include "rigs/hydrostatic/hydrostatic.hpp"
+#include "rigs/oedometer/oedometer.hpp"
+
+namespace rocklab::rigs {
+
+const std::vector<RigEntry>& rigTable() {
+  static const std::vector<RigEntry> table = {
+      {"oedometer",
+       "uniaxial strain: lateral walls fixed, axial strain rate or stress ramp, cycles, coring",
+       oedometer::declare, oedometer::validate, oedometer::run},
+      {"hydrostatic", "all walls servo-controlled to one stress, ramped up and optionally down",
+       hydrostatic::declare, hydrostatic::validate, hydrostatic::run},
+  };
+  return table;
+}
+
+const RigEntry& findRig(std::string_view name, const std::string& file) {
+  std::string known;
+  for (const RigEntry& r : rigTable()) {
+    if (r.name == name) return r;
+    known += (known.empty() ? "" : ", ") + std::string(r.name);
+  }
+  throw protocol::ProtocolError(
+      {file + ": protocol.rig = \"" + std::string(name) + "\" is not a rig: one of " + known});
+}
+
+protocol::Schema schemaOf(const RigEntry& rig) {
+  std::vector<std::string> names;
+  for (const RigEntry& r : rigTable()) names.emplace_back(r.name);
+  protocol::Schema s;
+  declareCommon(s, names);
+  rig.declare(s);
+  return s;
+}
+
+CheckedProtocol checkProtocol(const std::string& path) {
+  const std::string text = protocol::readFile(path);
+  const RigEntry& rig = findRig(protocol::rigOf(path, text), path);
+  CheckedProtocol c{&rig, protocol::parseProtocol(path, text, schemaOf(rig))};
+  validateCommon(c.settings);
+  rig.validate(c.settings);
+  return c;
+}
+
+}  // namespace rocklab::rigs

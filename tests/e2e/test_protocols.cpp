@@ -1,0 +1,221 @@
+// The quick protocols end to end: `rocklab run` into a fresh notebook, then what the paper's
+// section 1 says must show, read back from the notebook with SQL. Tolerances are stated at
+// each check; the measured values they guard are in the comments.
+
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "lab/notebook/queries.hpp"
+
+namespace {
+
+namespace nb = rocklab::notebook;
+
+std::string sourceDir() {
+  return ROCKLAB_SOURCE_DIR;
+}
+
+struct Lab {
+  std::string path;
+  explicit Lab(const std::string& name)
+      : path((std::filesystem::temp_directory_path() /
+              ("rocklab-e2e-" + std::to_string(::getpid()) + "-" + name + ".sqlite"))
+                 .string()) {
+    clean();
+  }
+  ~Lab() { clean(); }
+  void clean() {
+    for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(path + ext);
+  }
+};
+
+int runCommand(const std::string& args, std::string* out = nullptr) {
+  const std::string cmd = std::string(ROCKLAB_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string text;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), pipe)) text += buf.data();
+  const int status = pclose(pipe);
+  if (out) *out = text;
+  return WEXITSTATUS(status);
+}
+
+double result(nb::Notebook& n, const std::string& name) {
+  const auto t = nb::query(n, "SELECT value FROM results WHERE name = '" + name + "'");
+  EXPECT_EQ(t.rows.size(), 1u) << name;
+  return t.rows.empty() ? NAN : t.rows[0][0].real;
+}
+
+std::string scalar(nb::Notebook& n, const std::string& sql) {
+  const auto t = nb::query(n, sql);
+  return t.rows.empty() ? "" : t.rows[0][0].str();
+}
+
+TEST(QuickProtocols, OedometerFormedUnderStressShowsFigures1And2) {
+  Lab lab("oedometer");
+  std::string out;
+  ASSERT_EQ(runCommand("run " + sourceDir() +
+                           "/protocols/oedometer-formed-under-stress-quick.toml"
+                           " --quiet --threads 1 --lab " +
+                           lab.path,
+                       &out),
+            0)
+      << out;
+  nb::Notebook n(lab.path);
+  EXPECT_EQ(scalar(n, "SELECT status FROM runs"), "completed");
+
+  // Non-linear: the tangent modulus falls as bonds break (measured 3.5 -> 2.0 GPa, ratio
+  // 0.58; a linear material gives 1, and 0.8 leaves room for the scatter between seeds).
+  EXPECT_LT(result(n, "tangent_modulus_ratio"), 0.8);
+  // Bonds break from the start: the first break within the first 1% of the loading
+  // (measured at the first record, 0.0001 of 0.04), and a good share by a tenth of it.
+  EXPECT_LT(result(n, "axial_strain_at_first_break"), 0.01 * result(n, "axial_strain_final"));
+  EXPECT_GT(result(n, "broken_bonds_by_tenth_of_loading"), 0.05 * result(n, "broken_bonds_total"));
+  // The stress path steepens: d(lateral)/d(axial) grows (measured 0.11 -> 0.32, x3; ask for
+  // x1.5).
+  EXPECT_GT(result(n, "stress_path_slope_final"), 1.5 * result(n, "stress_path_slope_initial"));
+  // The lateral stress rises slowly at first: below the elastic K0 of the formation state.
+  EXPECT_LT(result(n, "stress_path_slope_initial"), 0.25);
+  // An early cycle is nearly elastic, a late one markedly plastic (loading tangent over
+  // unloading secant: measured 0.84 at 0.1% strain, 0.66 at 2%).
+  EXPECT_GT(result(n, "cycle1_modulus_ratio"), 0.75);
+  EXPECT_LT(result(n, "cycle2_modulus_ratio"), result(n, "cycle1_modulus_ratio") - 0.1);
+  // Quasi-static control is measured: well under the warning limits.
+  EXPECT_LT(result(n, "mean_unbalanced_force_ratio"), 0.02);
+  EXPECT_LT(result(n, "max_inertial_number"), 1e-3);
+  EXPECT_EQ(scalar(n, "SELECT count(*) FROM messages WHERE level = 'warning'"), "0");
+  // Every break is an event with its mode, position and kind; counts agree with the results.
+  EXPECT_EQ(std::stod(scalar(n,
+                             "SELECT count(*) FROM events WHERE kind = 'bond_break' AND "
+                             "stage = 'loading'")),
+            result(n, "broken_bonds_total"));
+  EXPECT_EQ(scalar(n, "SELECT count(*) FROM events WHERE mode NOT IN ('tensile', 'shear')"), "0");
+  EXPECT_EQ(scalar(n, "SELECT count(DISTINCT granular) FROM events"), "1");
+  // The parameters and stage timings are in the notebook.
+  EXPECT_EQ(scalar(n, "SELECT unit FROM params WHERE key = 'formation.axial_stress_MPa'"), "MPa");
+  EXPECT_NE(scalar(n, "SELECT count(*) FROM stage_timings WHERE stage = 'bonds'"), "0");
+  // Formed under stress: the axial stress when cemented is the formation stress.
+  EXPECT_NEAR(result(n, "axial_stress_after_formation_MPa"), 30.0, 0.3);
+}
+
+TEST(QuickProtocols, CoredSampleIsSofterAtFirstThanTheVirgin) {
+  Lab lab("coring");
+  std::string out;
+  ASSERT_EQ(runCommand("run " + sourceDir() +
+                           "/protocols/oedometer-core-damage-quick.toml"
+                           " --quiet --threads 1 --lab " +
+                           lab.path,
+                       &out),
+            0)
+      << out;
+  nb::Notebook n(lab.path);
+  // Measured 0.57: coring broke most bonds (released the stress they were cemented under).
+  EXPECT_LT(result(n, "cored_to_virgin_initial_modulus_ratio"), 0.8);
+  EXPECT_GT(result(n, "broken_bonds_by_coring"), 0.3 * result(n, "bonds_installed"));
+  // The cored sample has lost the virgin's non-linearity (ratio 1.04 against 0.57).
+  EXPECT_GT(result(n, "cored.tangent_modulus_ratio"),
+            result(n, "virgin.tangent_modulus_ratio") + 0.2);
+  EXPECT_NE(scalar(n, "SELECT count(*) FROM series WHERE name = 'cored.axial_stress_MPa'"), "0");
+  EXPECT_NE(scalar(n, "SELECT count(*) FROM series WHERE name = 'virgin.axial_stress_MPa'"), "0");
+  EXPECT_NE(scalar(n, "SELECT count(*) FROM events WHERE stage = 'coring'"), "0");
+}
+
+TEST(QuickProtocols, HydrostaticCellRuns) {
+  Lab lab("hydrostatic");
+  std::string out;
+  ASSERT_EQ(
+      runCommand("run " + sourceDir() +
+                     "/protocols/hydrostatic-quick.toml --quiet --threads 1 --lab " + lab.path,
+                 &out),
+      0)
+      << out;
+  nb::Notebook n(lab.path);
+  EXPECT_NEAR(result(n, "mean_stress_peak_MPa"), 60.0, 0.6);
+  EXPECT_LT(result(n, "porosity_at_peak"), result(n, "porosity_after_formation"));
+  EXPECT_GT(result(n, "broken_bonds_at_peak"), 0.0);
+}
+
+TEST(Protocols, InvalidProtocolWritesNothing) {
+  Lab lab("invalid");
+  const auto bad = std::filesystem::temp_directory_path() /
+                   ("rocklab-bad-" + std::to_string(::getpid()) + ".toml");
+  {
+    std::FILE* f = std::fopen(bad.c_str(), "w");
+    std::fputs(
+        "[protocol]\nname = \"x\"\nrig = \"oedometer\"\n[sample]\ncount = 100\n"
+        "[formation]\naxial_stress_MPa = -30\n",
+        f);
+    std::fclose(f);
+  }
+  std::string out;
+  EXPECT_EQ(runCommand("run " + bad.string() + " --lab " + lab.path, &out), 2);
+  EXPECT_NE(out.find(bad.string() + ":7: formation.axial_stress_MPa = -30 is outside the allowed "
+                                    "range (0, 10000] (MPa)"),
+            std::string::npos)
+      << out;
+  EXPECT_FALSE(std::filesystem::exists(lab.path));
+  EXPECT_EQ(runCommand("check " + bad.string(), &out), 2);
+  std::filesystem::remove(bad);
+  EXPECT_EQ(
+      runCommand("check " + sourceDir() + "/protocols/oedometer-formed-under-stress.toml", &out), 0)
+      << out;
+}
+
+// SIGTERM during a run: the run is closed as interrupted, with what it recorded until then.
+TEST(Protocols, SigtermLeavesAnInterruptedRunWithItsData) {
+  Lab lab("sigterm");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string protocol =
+        sourceDir() + "/protocols/oedometer-formed-under-stress-quick.toml";
+    execl(ROCKLAB_BINARY, ROCKLAB_BINARY, "run", protocol.c_str(), "--quiet", "--threads", "1",
+          "--lab", lab.path.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(15));  // well into formation or loading
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  nb::Notebook n(lab.path);
+  EXPECT_EQ(scalar(n, "SELECT status || ': ' || reason FROM runs"),
+            "interrupted: terminated (SIGTERM)");
+  EXPECT_NE(scalar(n, "SELECT count(*) FROM series"), "0");
+}
+
+TEST(Protocols, NotebookCommandsQueryTheLab) {
+  Lab lab("queries");
+  std::string out;
+  ASSERT_EQ(
+      runCommand("run " + sourceDir() +
+                     "/protocols/hydrostatic-quick.toml --quiet --threads 1 --lab " + lab.path,
+                 &out),
+      0)
+      << out;
+  EXPECT_EQ(runCommand("notebook runs --lab " + lab.path, &out), 0);
+  EXPECT_NE(out.find("hydrostatic-quick"), std::string::npos) << out;
+  EXPECT_EQ(runCommand("notebook show 1 --lab " + lab.path, &out), 0);
+  EXPECT_NE(out.find("secant_bulk_modulus_MPa"), std::string::npos) << out;
+  EXPECT_EQ(runCommand("notebook series 1 loading.porosity --csv --lab " + lab.path, &out), 0);
+  EXPECT_EQ(out.rfind("name,step,time_s,value\nloading.porosity,", 0), 0u) << out.substr(0, 200);
+  EXPECT_EQ(runCommand("notebook events 1 --kind bond_break --csv --lab " + lab.path, &out), 0);
+  EXPECT_NE(out.find("bond_break"), std::string::npos);
+  EXPECT_EQ(runCommand("notebook sql \"SELECT count(*) AS n FROM runs\" --lab " + lab.path, &out),
+            0);
+  EXPECT_EQ(out, "n\n1\n");
+  EXPECT_NE(runCommand("notebook show 7 --lab " + lab.path, &out), 0);
+  EXPECT_NE(out.find("no run 7"), std::string::npos) << out;
+}
+
+}  // namespace
