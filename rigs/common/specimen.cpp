@@ -260,7 +260,8 @@ Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
   spec.aspect[D - 1] = s.real("sample.aspect_axial");
   spec.thickness = s.real("sample.thickness_m");
   spec.seed = static_cast<std::uint64_t>(s.integer("protocol.seed"));
-  spec.threads = static_cast<int>(s.integer("numerics.threads"));
+    spec.threads = static_cast<int>(s.integer("numerics.threads"));
+  spec.progress = [&](double f) { control.tick("packing", 0, f, "radius expansion"); };
   const Packing<D> p = generatePacking<D>(spec);
 
   Specimen<D> sp;
