@@ -28,9 +28,9 @@ if(NOT CGAL_FOUND)
 endif()
 
 find_package(VTK QUIET COMPONENTS
-  RenderingOpenGL2 RenderingCore RenderingFreeType ChartsCore ViewsContext2D
+  RenderingOpenGL2 RenderingCore RenderingFreeType RenderingAnnotation ChartsCore ViewsContext2D
   RenderingContextOpenGL2 InteractionStyle IOImage IOXML FiltersSources CommonCore
-  CommonDataModel)
+  CommonDataModel IOXMLParser)
 if(NOT VTK_FOUND)
   rocklab_missing("VTK 9 (charts, snapshots, ParaView export)" "libvtk9-dev")
 endif()

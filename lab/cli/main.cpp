@@ -10,6 +10,7 @@
 #include "lab/cli/lab_commands.hpp"
 #include "lab/core/contact_laws.hpp"
 #include "lab/core/packing_io.hpp"
+#include "reports/report.hpp"
 
 namespace {
 
@@ -182,6 +183,41 @@ int main(int argc, char** argv) {
     sub->add_flag("--csv", nbo.csv, "Print CSV");
   }
   nbc->callback([&] { action = [&] { return rocklab::cli::notebookCommand(nbo); }; });
+
+  rocklab::reports::ReportOptions report;
+  report.data_dir = ROCKLAB_DATA_DIR;
+  auto* rep =
+      app.add_subcommand("report",
+                         "Write a figure report of runs: index.html, PNG figures with their CSV, "
+                         "snapshots rendered off screen, the paper's numbers beside the runs'");
+  rep->add_option("runs", report.runs, "Run ids (their figures overlay)")->required();
+  rep->add_option("--lab", report.lab, "Lab notebook (SQLite)");
+  rep->add_option("--out", report.out, "Output folder")->required();
+  rep->add_option("--field", report.field, "Snapshot colouring")
+      ->check(CLI::IsMember({"displacement", "velocity", "broken_bonds"}));
+  rep->add_option("--data", report.data_dir, "Folder holding paper.toml");
+  rep->callback([&] {
+    action = [&] {
+      const auto s = rocklab::reports::writeReport(report);
+      std::cout << "wrote " << report.out << "/index.html (" << s.files.size() << " files, "
+                << static_cast<int>(s.seconds + 0.5) << " s)\n";
+      return 0;
+    };
+  });
+
+  std::string export_lab = "lab.sqlite", export_dir;
+  std::int64_t export_run = 0;
+  auto* exp = app.add_subcommand("export", "Write a run's state frames for ParaView");
+  exp->add_option("run", export_run, "Run id")->required();
+  exp->add_option("--vtk", export_dir, "Output folder (.vtp per frame and a .pvd)")->required();
+  exp->add_option("--lab", export_lab, "Lab notebook (SQLite)");
+  exp->callback([&] {
+    action = [&] {
+      std::cout << "wrote " << rocklab::reports::exportRun(export_lab, export_run, export_dir)
+                << "\n";
+      return 0;
+    };
+  });
 
   int dim = 3;
   rocklab::PackingSpec spec;

@@ -29,9 +29,15 @@ struct IsEigenFixed : std::false_type {};
 template <int R>
 struct IsEigenFixed<Eigen::Matrix<double, R, 1>> : std::true_type {};
 
+template <class T>
+struct IsArithmeticArray : std::false_type {};
+template <class T, std::size_t N>
+struct IsArithmeticArray<std::array<T, N>> : std::bool_constant<std::is_arithmetic_v<T>> {};
+
 // Element types stored as plain bytes, so vectors of them are copied in one block.
 template <class T>
-constexpr bool kPlainBytes = std::is_arithmetic_v<T> || IsEigenFixed<T>::value;
+constexpr bool kPlainBytes =
+    std::is_arithmetic_v<T> || IsEigenFixed<T>::value || IsArithmeticArray<T>::value;
 
 template <class T>
 concept PlainVector = requires(T v) {

@@ -863,6 +863,18 @@ double Simulation<D>::maxOverlapRatio() const {
 }
 
 template <int D>
+std::vector<typename Simulation<D>::ContactForce> Simulation<D>::contactForces() const {
+  std::vector<ContactForce> out;
+  if (!model_) return out;
+  forEachTouching([&](const Touching& t) {
+    if (t.wall) return;
+    out.push_back({t.i, t.j, model_->normalForce(t.mi, t.mj, t.overlap, t.shape),
+                   std::sqrt(t.shear2)});
+  });
+  return out;
+}
+
+template <int D>
 double Simulation<D>::coordinationNumber() const {
   return particles_.size() ? 2.0 * static_cast<double>(particleContacts()) /
                                  static_cast<double>(particles_.size())

@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <tuple>
 
 namespace rocklab::notebook {
@@ -140,9 +142,22 @@ CREATE TABLE messages (
 );
 CREATE INDEX messages_by_run ON messages (run_id, step);
 )sql",
-      // 2 -> 3: the protocol stage an event happened in.
+            // 2 -> 3: the protocol stage an event happened in.
       R"sql(
 ALTER TABLE events ADD COLUMN stage TEXT;
+)sql",
+      // 3 -> 4: snapshot files (state frames, rendered images) of a run.
+      R"sql(
+CREATE TABLE snapshots (
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  step INTEGER NOT NULL,
+  time_s REAL NOT NULL,
+  stage TEXT NOT NULL,
+  label TEXT NOT NULL,
+  kind TEXT NOT NULL,
+  path TEXT NOT NULL
+);
+CREATE INDEX snapshots_by_run ON snapshots (run_id, step);
 )sql",
   };
   return m;
@@ -154,6 +169,14 @@ Notebook::Notebook(const std::string& path) : db_(std::make_unique<Connection>(p
   db_->exec("PRAGMA synchronous = NORMAL");
   migrate(kSchemaVersion);
   closeOrphanRuns();
+}
+
+std::string Notebook::runFilesDir(std::int64_t run) const {
+  return path() + ".files/run-" + std::to_string(run);
+}
+
+std::string Notebook::resolve(const std::string& relative) const {
+  return (std::filesystem::path(path()).parent_path() / relative).string();
 }
 
 void Notebook::createAtVersion(const std::string& path, int version) {
@@ -224,6 +247,30 @@ RunWriter::~RunWriter() {
     finish(RunStatus::Failed, "the run ended without being closed");
   } catch (...) {
   }
+}
+
+void RunWriter::snapshot(std::string_view kind, std::string_view stage, std::string_view label,
+                         std::uint64_t step, double time, const std::string& bytes,
+                         std::string_view extension) {
+  namespace fs = std::filesystem;
+  const fs::path dir = nb_.runFilesDir(id_);
+  fs::create_directories(dir);
+  const std::string name = std::string(stage) + "-" + std::to_string(step) + "." +
+                           std::string(extension);
+  const fs::path file = dir / name;
+  {
+    std::ofstream out(file.string() + ".partial", std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw SqlError("cannot write '" + file.string() + "'");
+  }
+  fs::rename(file.string() + ".partial", file);
+    const std::string relative =
+      fs::relative(fs::absolute(file), fs::absolute(nb_.path()).parent_path()).string();
+  auto s = nb_.db().prepare(
+      "INSERT INTO snapshots (run_id, step, time_s, stage, label, kind, path) "
+      "VALUES (?, ?, ?, ?, ?, ?, ?)");
+  s.bind(1, id_).bind(2, step).bind(3, time).bind(4, stage).bind(5, label).bind(6, kind);
+  s.bind(7, relative).run();
 }
 
 void RunWriter::flushIfDue() {

@@ -16,7 +16,7 @@
 
 namespace rocklab::notebook {
 
-inline constexpr int kSchemaVersion = 3;
+inline constexpr int kSchemaVersion = 4;
 
 // Opens a lab notebook, creating it if needed, and brings its schema up to date. Runs a
 // previous process left `running` on this host and that process is gone are marked failed.
@@ -24,7 +24,11 @@ class Notebook {
  public:
   explicit Notebook(const std::string& path);
   Connection& db() { return *db_; }
-  const std::string& path() const { return db_->path(); }
+    const std::string& path() const { return db_->path(); }
+  // Files of a run (snapshots, images) live beside the notebook, in <notebook>.files/run-N;
+  // the notebook records them by paths relative to its own directory.
+  std::string runFilesDir(std::int64_t run) const;
+  std::string resolve(const std::string& relative) const;
   // The schema migrations, in order; [k] takes version k to k + 1.
   static const std::vector<std::string_view>& migrations();
   // For tests: open a database and migrate it only up to `version`.
@@ -81,7 +85,11 @@ class RunWriter {
   void event(const EventRow& e);
   void message(std::uint64_t step, double time, std::string_view level, std::string_view text);
   void result(std::string_view name, double value, std::string_view unit);
-  void stageTiming(std::string_view stage, double seconds, std::uint64_t calls);
+    void stageTiming(std::string_view stage, double seconds, std::uint64_t calls);
+  // Writes a file of the run (a state frame, kind "frame") and records it in `snapshots`.
+  void snapshot(std::string_view kind, std::string_view stage, std::string_view label,
+                std::uint64_t step, double time, const std::string& bytes,
+                std::string_view extension);
   void flush();
   void finish(RunStatus status, std::string_view reason = {});
 

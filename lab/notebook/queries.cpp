@@ -45,6 +45,8 @@ std::vector<std::pair<std::string, Table>> showRun(Notebook& nb, std::int64_t ru
                          "SELECT stage, round(seconds, 3) AS seconds, calls FROM stage_timings "
                          "WHERE run_id = " +
                              id + " ORDER BY seconds DESC"));
+    out.emplace_back("snapshots", query(nb, "SELECT step, time_s, stage, label, kind, path FROM "
+                                          "snapshots WHERE run_id = " + id + " ORDER BY step"));
   out.emplace_back("messages", query(nb,
                                      "SELECT step, time_s, level, text FROM messages WHERE "
                                      "run_id = " +

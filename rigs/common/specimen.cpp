@@ -119,8 +119,14 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
                "warn when the inertial number of a loading stage exceeds this"),
         0, true, 10, false);
 
-  range(s.integer("output.record_every_steps", 500, "steps between recorded measurements"), 1,
+    range(s.integer("output.record_every_steps", 500, "steps between recorded measurements"), 1,
         false, 1e9, false);
+  s.flag("output.snapshots", true,
+         "save frames of the state (particles, contacts, bonds, walls) when the sample is "
+         "formed and at the end of each loading stage, for reports and ParaView");
+  range(s.integer("output.snapshot_every_steps", 0,
+                  "also save a frame every this many loading steps (0: none)"),
+        0, false, 1e12, false);
 }
 
 void validateCommon(const Settings& s) {
@@ -268,7 +274,8 @@ Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
   sp.mean_radius =
       std::accumulate(p.radii.begin(), p.radii.end(), 0.0) / static_cast<double>(p.radii.size());
   sp.density = s.real("material.density_kg_per_m3");
-  sp.record_every = static_cast<std::uint64_t>(s.integer("output.record_every_steps"));
+    sp.record_every = static_cast<std::uint64_t>(s.integer("output.record_every_steps"));
+  sp.snapshot_every = static_cast<std::uint64_t>(s.integer("output.snapshot_every_steps"));
   SimulationConfig cfg;
   cfg.contact_law = s.text("material.contact_law");
   cfg.skin = s.real("numerics.skin_ratio") * sp.mean_radius;
@@ -342,9 +349,18 @@ void formAndCement(Specimen<D>& sp, const Settings& s, Recorder& rec, RunControl
                     " strength draws <= 0 left uncemented (bonds.negative_strength = " +
                     s.text("bonds.negative_strength") + ")");
   }
-  sim.restartEnergyLedger();
+    sim.restartEnergyLedger();
   sp.frame->resetReference();
   sp.resetBrokenCount();
+  snapshot(sp, s, rec, "formation", "formed");
+}
+
+template <int D>
+void snapshot(Specimen<D>& sp, const Settings& s, Recorder& rec, const std::string& stage,
+              const std::string& label) {
+  if (!s.flag("output.snapshots")) return;
+  recordBreaks(sp, rec, stage);  // the breaks up to the frame are in the notebook with it
+  rec.snapshot(stage, label, captureFrame(*sp.sim));
 }
 
 template <int D>
@@ -454,6 +470,10 @@ template void recordState<2>(Specimen<2>&, Recorder&, const std::string&, const 
 template void recordState<3>(Specimen<3>&, Recorder&, const std::string&, const std::string&,
                              double);
 template void recordBreaks<2>(Specimen<2>&, Recorder&, const std::string&);
+template void snapshot<2>(Specimen<2>&, const Settings&, Recorder&, const std::string&,
+                          const std::string&);
+template void snapshot<3>(Specimen<3>&, const Settings&, Recorder&, const std::string&,
+                          const std::string&);
 template void recordBreaks<3>(Specimen<3>&, Recorder&, const std::string&);
 template double inertialNumber<2>(const Specimen<2>&, double);
 template double inertialNumber<3>(const Specimen<3>&, double);

@@ -42,8 +42,9 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
 
   // The ramp up and the hold at the peak are recorded as series (stresses, volumetric
   // strain, porosity, broken bonds) under the stage names.
-  servoTo(sp, s, s.si("loading.stress_max_MPa"), s.si("loading.stress_max_MPa"), rate, "loading",
+    servoTo(sp, s, s.si("loading.stress_max_MPa"), s.si("loading.stress_max_MPa"), rate, "loading",
           rec, control);
+  snapshot(sp, s, rec, "loading", "peak");
   rec.result("mean_stress_peak_MPa", frame.meanStress() / 1e6, "MPa");
   rec.result("volumetric_strain_at_peak", frame.volumetricStrain(), "");
   rec.result("secant_bulk_modulus_MPa", (frame.meanStress() - p0) / frame.volumetricStrain() / 1e6,
@@ -55,7 +56,8 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   if (s.real("loading.unload_to_MPa") > 0.0) {
     servoTo(sp, s, s.si("loading.unload_to_MPa"), s.si("loading.unload_to_MPa"), rate, "unloading",
             rec, control);
-    rec.result("volumetric_strain_after_unloading", frame.volumetricStrain(), "");
+        rec.result("volumetric_strain_after_unloading", frame.volumetricStrain(), "");
+    snapshot(sp, s, rec, "unloading", "final");
   }
   for (const StageTiming& t : sp.sim->stageTimings()) rec.stageTiming(t.name, t.seconds, t.calls);
 }

@@ -174,12 +174,16 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
       phase = 0;
       ++next_cycle;
     }
-    const bool finished = strain_control ? strain >= strain_max : stress >= stress_max;
+        const bool finished = strain_control ? strain >= strain_max : stress >= stress_max;
     if (finished) {
       record();
+      snapshot(sp, s, rec, stage, "final");
       break;
     }
-    if ((sim.steps() - start) % sp.record_every == 0) record();
+        if ((sim.steps() - start) % sp.record_every == 0) record();
+    if (sp.snapshot_every && (sim.steps() - start) % sp.snapshot_every == 0) {
+      snapshot(sp, s, rec, stage, "step " + std::to_string(sim.steps() - start));
+    }
     if (sim.steps() % 100 == 0) {
       const double fraction =
           strain_control ? strain / strain_max : (stress - sigma0) / (stress_max - sigma0);

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "lab/core/archive.hpp"
+#include "lab/core/frame.hpp"
 #include "lab/core/packing.hpp"
 #include "tests/support.hpp"
 
@@ -111,6 +112,27 @@ TEST(Checkpoint, RestartContinuesBitForBit) {
   EXPECT_EQ(a.bonds().size(), b.bonds().size());
   EXPECT_EQ(a.takeBondBreaks().size(), b.takeBondBreaks().size());
   std::filesystem::remove(path);
+}
+
+TEST(Frames, CaptureEncodeDecode) {
+  Simulation<3> sim = scene();
+  sim.run(50);
+  const Frame f = captureFrame(sim);
+  EXPECT_EQ(f.size(), sim.particles().size());
+  EXPECT_EQ(f.bonds.size(), sim.bonds().size());
+  EXPECT_EQ(f.contacts.size(), sim.particleContacts());
+  EXPECT_EQ(f.walls.size(), 6u);
+  const std::string path = tempPath("frame.rkf");
+  writeFrame(path, f);
+  const Frame g = readFrame(path);
+  EXPECT_EQ(g.step, f.step);
+  EXPECT_EQ(g.pos, f.pos);
+  EXPECT_EQ(g.slot, f.slot);
+  ASSERT_EQ(g.contacts.size(), f.contacts.size());
+  EXPECT_EQ(g.contacts.back().normal, f.contacts.back().normal);
+  EXPECT_EQ(g.walls[5].name, "zmax");
+  std::filesystem::remove(path);
+  EXPECT_THROW(decodeFrame("not a frame at all", "x"), CheckpointError);
 }
 
 class DamagedCheckpoint : public ::testing::Test {

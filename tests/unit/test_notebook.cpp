@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "lab/notebook/queries.hpp"
@@ -46,8 +47,8 @@ TEST_F(NotebookTest, NewNotebookHasTheSchemaWalAndForeignKeys) {
   EXPECT_EQ(nb.db().userVersion(), kSchemaVersion);
   EXPECT_EQ(scalar(nb, "PRAGMA journal_mode"), "wal");
   EXPECT_EQ(scalar(nb, "PRAGMA foreign_keys"), "1");
-  for (const char* t :
-       {"runs", "params", "series", "events", "stage_timings", "results", "messages"}) {
+    for (const char* t :
+       {"runs", "params", "series", "events", "stage_timings", "results", "messages", "snapshots"}) {
     EXPECT_EQ(
         scalar(nb, std::string("SELECT count(*) FROM sqlite_master WHERE name = '") + t + "'"), "1")
         << t;
@@ -87,6 +88,21 @@ TEST_F(NotebookTest, RecordsARunAndClosesIt) {
   // Deleting a run takes its records with it (foreign keys).
   nb.db().exec("DELETE FROM runs");
   EXPECT_EQ(scalar(nb, "SELECT count(*) FROM series"), "0");
+}
+
+TEST_F(NotebookTest, SnapshotFilesLiveBesideTheNotebookAndAreRecorded) {
+  Notebook nb(path_);
+  RunWriter w(nb, info(), {});
+  w.snapshot("frame", "loading", "final", 1234, 0.5, std::string("abc\0def", 7), "rkf");
+  w.finish(RunStatus::Completed);
+  const std::string rel = scalar(nb, "SELECT path FROM snapshots");
+  EXPECT_EQ(rel, std::filesystem::path(path_).filename().string() + ".files/run-1/loading-1234.rkf");
+  std::ifstream in(nb.resolve(rel), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(bytes, std::string("abc\0def", 7));
+  EXPECT_EQ(scalar(nb, "SELECT label || ' ' || kind || ' ' || stage FROM snapshots"),
+            "final frame loading");
+  std::filesystem::remove_all(nb.runFilesDir(1));
 }
 
 TEST_F(NotebookTest, AWriterLeftOpenMarksTheRunFailedAndKeepsItsData) {

@@ -1,0 +1,124 @@
+#include "reports/chart.hpp"
+
+#include <vtkAxis.h>
+#include <vtkChartLegend.h>
+#include <vtkChartMatrix.h>
+#include <vtkChartXY.h>
+#include <vtkContextScene.h>
+#include <vtkContextView.h>
+#include <vtkDoubleArray.h>
+#include <vtkNew.h>
+#include <vtkPen.h>
+#include <vtkPlot.h>
+#include <vtkPlotPoints.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkTable.h>
+#include <vtkTextProperty.h>
+#include <vtkVector.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "reports/offscreen.hpp"
+
+namespace rocklab::reports {
+
+namespace {
+
+// Okabe & Ito's palette, distinguishable with colour-blind vision.
+constexpr unsigned char kPalette[][3] = {{0, 0, 0},       {230, 159, 0}, {86, 180, 233},
+                                         {0, 158, 115},   {213, 94, 0},  {0, 114, 178},
+                                         {204, 121, 167}, {240, 228, 66}};
+
+void writeCsv(const Figure& f, const std::string& path) {
+  std::ofstream out(path);
+  out.precision(10);
+  out << "panel,series,x,y\n";
+  for (std::size_t p = 0; p < f.panels.size(); ++p) {
+    for (const Series& s : f.panels[p].series) {
+      std::string label = s.label;
+      for (char& c : label) {
+        if (c == ',' || c == '"') c = ' ';
+      }
+      for (std::size_t k = 0; k < s.x.size(); ++k) {
+        out << p + 1 << "," << label << "," << s.x[k] << "," << s.y[k] << "\n";
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void renderFigure(const Figure& f, const std::string& dir) {
+  const int panels = static_cast<int>(f.panels.size());
+  Canvas canvas(900, 420 * panels + 40);
+  vtkNew<vtkContextView> view;
+  view->SetRenderWindow(canvas.window());
+  view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
+  vtkNew<vtkChartMatrix> matrix;
+  matrix->SetSize(vtkVector2i(1, panels));
+  matrix->SetGutter(vtkVector2f(30.0f, 60.0f));
+  view->GetScene()->AddItem(matrix);
+  for (int p = 0; p < panels; ++p) {
+    const Panel& panel = f.panels[p];
+    // Panel 1 on top: the matrix counts rows from the bottom.
+    auto* chart = vtkChartXY::SafeDownCast(matrix->GetChart(vtkVector2i(0, panels - 1 - p)));
+    chart->SetShowLegend(true);
+    chart->GetLegend()->GetLabelProperties()->SetFontSize(13);
+    chart->GetAxis(vtkAxis::BOTTOM)->SetTitle(panel.x_label);
+    chart->GetAxis(vtkAxis::LEFT)->SetTitle(panel.y_label);
+    for (int a : {vtkAxis::BOTTOM, vtkAxis::LEFT}) {
+      chart->GetAxis(a)->GetTitleProperties()->SetFontSize(15);
+      chart->GetAxis(a)->GetLabelProperties()->SetFontSize(13);
+    }
+    if (p == 0) chart->SetTitle(f.title);
+    chart->GetTitleProperties()->SetFontSize(16);
+        // Axis ranges with a margin of 5% around all the data, so that points on the extremes
+    // (the paper's) stay visible.
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (const Series& s : panel.series) {
+      for (std::size_t i = 0; i < s.x.size(); ++i) {
+        if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+        lo[0] = std::min(lo[0], s.x[i]), hi[0] = std::max(hi[0], s.x[i]);
+        lo[1] = std::min(lo[1], s.y[i]), hi[1] = std::max(hi[1], s.y[i]);
+      }
+    }
+    for (int a = 0; a < 2 && hi[0] >= lo[0]; ++a) {
+      const double pad = hi[a] > lo[a] ? 0.05 * (hi[a] - lo[a]) : 0.5 * std::abs(hi[a]) + 1.0;
+      vtkAxis* axis = chart->GetAxis(a == 0 ? vtkAxis::BOTTOM : vtkAxis::LEFT);
+      axis->SetBehavior(vtkAxis::FIXED);
+      axis->SetRange(lo[a] - pad, hi[a] + pad);
+    }
+    for (std::size_t k = 0; k < panel.series.size(); ++k) {
+      const Series& s = panel.series[k];
+      if (s.x.empty()) continue;
+      vtkNew<vtkTable> table;
+      vtkNew<vtkDoubleArray> x, y;
+      x->SetName((panel.x_label + "#" + std::to_string(k)).c_str());
+      y->SetName(s.label.c_str());
+      table->AddColumn(x);
+      table->AddColumn(y);
+      table->SetNumberOfRows(static_cast<vtkIdType>(s.x.size()));
+      for (std::size_t i = 0; i < s.x.size(); ++i) {
+        table->SetValue(static_cast<vtkIdType>(i), 0, s.x[i]);
+        table->SetValue(static_cast<vtkIdType>(i), 1, s.y[i]);
+      }
+      vtkPlot* plot = chart->AddPlot(s.markers ? vtkChart::POINTS : vtkChart::LINE);
+      plot->SetInputData(table, 0, 1);
+      const auto* c = kPalette[k % 8];
+      plot->SetColor(c[0], c[1], c[2], 255);
+      plot->SetWidth(s.markers ? 1.0f : 2.0f);
+      plot->SetLabel(s.label);
+      if (auto* pts = vtkPlotPoints::SafeDownCast(plot)) {  // lines derive from points
+        pts->SetMarkerStyle(s.markers ? vtkPlotPoints::DIAMOND : vtkPlotPoints::NONE);
+        pts->SetMarkerSize(12.0f);
+      }
+    }
+  }
+      canvas.savePng(dir + "/" + f.id + ".png");
+  writeCsv(f, dir + "/" + f.id + ".csv");
+}
+
+}  // namespace rocklab::reports

@@ -1,0 +1,31 @@
+#pragma once
+// Line charts for reports: a figure of one or more stacked panels, several series each
+// (several runs overlay), rendered off screen to PNG with the CSV behind it.
+
+#include <string>
+#include <vector>
+
+namespace rocklab::reports {
+
+struct Series {
+  std::string label;
+  std::vector<double> x, y;
+  bool markers = false;  // points (e.g. a value from the paper) instead of a line
+};
+
+struct Panel {
+  std::string x_label, y_label;
+  std::vector<Series> series;
+};
+
+struct Figure {
+  std::string id;  // file stem: id.png, id.csv
+  std::string title;
+  std::string caption;
+  std::vector<Panel> panels;
+};
+
+// Writes dir/<id>.png and dir/<id>.csv (columns panel, series, x, y).
+void renderFigure(const Figure& f, const std::string& dir);
+
+}  // namespace rocklab::reports
