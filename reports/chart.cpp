@@ -75,7 +75,7 @@ void renderFigure(const Figure& f, const std::string& dir) {
     }
     if (p == 0) chart->SetTitle(f.title);
     chart->GetTitleProperties()->SetFontSize(16);
-        // Axis ranges with a margin of 5% around all the data, so that points on the extremes
+    // Axis ranges with a margin of 5% around all the data, so that points on the extremes
     // (the paper's) stay visible.
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     for (const Series& s : panel.series) {
@@ -117,7 +117,7 @@ void renderFigure(const Figure& f, const std::string& dir) {
       }
     }
   }
-      canvas.savePng(dir + "/" + f.id + ".png");
+  canvas.savePng(dir + "/" + f.id + ".png");
   writeCsv(f, dir + "/" + f.id + ".csv");
 }
 

@@ -216,25 +216,56 @@ void decorate(vtkRenderer* r, vtkLookupTable* lut, const FieldValues& field,
   r->AddActor2D(text);
 }
 
+// The parts every snapshot has: the canvas, a white renderer, the colour map, the centre.
+struct Scene {
+  Canvas canvas{1000, 800};
+  vtkNew<vtkRenderer> renderer;
+  vtkNew<vtkLookupTable> lut;
+  std::array<double, 3> centre;
+  double band;  // mean radius: breaks this close to the mid-plane are drawn on it
+  Scene(const Frame& f, const FieldValues& field)
+      : lut(viridis(field.lo, field.hi)), centre(centreOf(f)), band(meanRadius(f)) {
+    renderer->SetBackground(1.0, 1.0, 1.0);
+    canvas.window()->AddRenderer(renderer);
+  }
+  std::vector<BreakMark> nearMidPlane(const std::vector<BreakMark>& breaks) const {
+    std::vector<BreakMark> near;
+    for (const BreakMark& b : breaks) {
+      if (std::abs(b.position[1] - centre[1]) < band) near.push_back(b);
+    }
+    return near;
+  }
+  // A parallel camera looking along +y from `position`, z up.
+  void look(const std::array<double, 3>& focus, const std::array<double, 3>& position) {
+    vtkCamera* cam = renderer->GetActiveCamera();
+    cam->ParallelProjectionOn();
+    cam->SetFocalPoint(focus[0], focus[1], focus[2]);
+    cam->SetPosition(position[0], position[1], position[2]);
+    cam->SetViewUp(0.0, 0.0, 1.0);
+    renderer->ResetCamera();
+    cam->Zoom(1.1);
+  }
+};
+
 }  // namespace
 
 void renderView(const Frame& f, const FieldValues& field, const std::vector<BreakMark>& breaks,
                 const std::string& title, const std::string& png) {
-  Canvas canvas(1000, 800);
-  vtkNew<vtkRenderer> r;
-  r->SetBackground(1.0, 1.0, 1.0);
-  canvas.window()->AddRenderer(r);
-  auto lut = viridis(field.lo, field.hi);
-  const auto c = centreOf(f);
+  Scene sc(f, field);
+  const auto& c = sc.centre;
+  const Bounds b = boundsOf(f);
+  const double width = (b.hi[0] - b.lo[0]) * kMm;
   if (f.dimension == 2) {
-    // Disks in the x-y plane, the camera along z.
+    // Disks in the x-y plane drawn in the x-z plane, the camera along y.
     std::vector<std::array<double, 3>> centres;
     for (const auto& p : f.pos) centres.push_back({p[0], 0.0, p[1]});
-    auto actor = particleActor(centres, f.radius, field.values, lut, true);
-    r->AddActor(actor);
+    sc.renderer->AddActor(particleActor(centres, f.radius, field.values, sc.lut, true));
     std::vector<BreakMark> flat;
-    for (BreakMark b : breaks) flat.push_back({{b.position[0], 0.0, b.position[1]}, b.tensile});
-    addBreaks(r, flat, 0.25 * meanRadius(f) * kMm, true, -0.01 * meanRadius(f) * kMm);
+    for (const BreakMark& m : breaks)
+      flat.push_back({{m.position[0], 0.0, m.position[1]}, m.tensile});
+    addBreaks(sc.renderer, flat, 0.25 * sc.band * kMm, true, -0.01 * sc.band * kMm);
+    addScaleBar(sc.renderer, b.lo[0] * kMm, width, -0.02 * width, b.lo[1] * kMm - 0.06 * width);
+    sc.look({c[0] * kMm, 0.0, c[1] * kMm}, {c[0] * kMm, -1e3, c[1] * kMm});
   } else {
     // The half behind the mid-plane y = centre: its cut face shows the interior.
     std::vector<std::array<double, 3>> centres;
@@ -245,46 +276,21 @@ void renderView(const Frame& f, const FieldValues& field, const std::vector<Brea
       radii.push_back(f.radius[i]);
       values.push_back(field.values[i]);
     }
-    r->AddActor(particleActor(centres, radii, values, lut, false));
-    std::vector<BreakMark> near;
-    const double band = meanRadius(f);
-    for (const BreakMark& b : breaks) {
-      if (std::abs(b.position[1] - c[1]) < band) near.push_back(b);
-    }
-    addBreaks(r, near, 0.3 * band * kMm, true, (c[1] - band) * kMm);
+    sc.renderer->AddActor(particleActor(centres, radii, values, sc.lut, false));
+    addBreaks(sc.renderer, sc.nearMidPlane(breaks), 0.3 * sc.band * kMm, true,
+              (c[1] - sc.band) * kMm);
+    addScaleBar(sc.renderer, b.lo[0] * kMm, width, b.lo[1] * kMm, b.lo[2] * kMm - 0.06 * width);
+    sc.look({c[0] * kMm, c[1] * kMm, c[2] * kMm},
+            {c[0] * kMm - 400.0, c[1] * kMm - 1000.0, c[2] * kMm + 350.0});
   }
-  const Bounds b = boundsOf(f);
-  const double width = (b.hi[0] - b.lo[0]) * kMm;
-  if (f.dimension == 2) {
-    addScaleBar(r, b.lo[0] * kMm, width, -0.02 * width, b.lo[1] * kMm - 0.06 * width);
-  } else {
-    addScaleBar(r, b.lo[0] * kMm, width, b.lo[1] * kMm, b.lo[2] * kMm - 0.06 * width);
-  }
-  r->ResetCamera();
-  vtkCamera* cam = r->GetActiveCamera();
-  cam->ParallelProjectionOn();
-  cam->SetFocalPoint(c[0] * kMm, c[1] * kMm, (f.dimension == 2 ? c[1] : c[2]) * kMm);
-  if (f.dimension == 2) {
-    cam->SetFocalPoint(c[0] * kMm, 0.0, c[1] * kMm);
-    cam->SetPosition(c[0] * kMm, -1e3, c[1] * kMm);
-  } else {
-    cam->SetPosition(c[0] * kMm - 400.0, c[1] * kMm - 1000.0, c[2] * kMm + 350.0);
-  }
-  cam->SetViewUp(0.0, 0.0, 1.0);
-  r->ResetCamera();
-  cam->Zoom(1.1);
-  decorate(r, lut, field, title, !breaks.empty());
-  canvas.savePng(png);
+  decorate(sc.renderer, sc.lut, field, title, !breaks.empty());
+  sc.canvas.savePng(png);
 }
 
 void renderSlice(const Frame& f, const FieldValues& field, const std::vector<BreakMark>& breaks,
                  const std::string& title, const std::string& png) {
-  Canvas canvas(1000, 800);
-  vtkNew<vtkRenderer> r;
-  r->SetBackground(1.0, 1.0, 1.0);
-  canvas.window()->AddRenderer(r);
-  auto lut = viridis(field.lo, field.hi);
-  const auto c = centreOf(f);
+  Scene sc(f, field);
+  const auto& c = sc.centre;
   // Each sphere the plane y = centre cuts leaves a disk of radius sqrt(r^2 - d^2).
   std::vector<std::array<double, 3>> centres;
   std::vector<double> radii, values;
@@ -295,27 +301,19 @@ void renderSlice(const Frame& f, const FieldValues& field, const std::vector<Bre
     radii.push_back(std::sqrt(f.radius[i] * f.radius[i] - d * d));
     values.push_back(field.values[i]);
   }
-  r->AddActor(particleActor(centres, radii, values, lut, true));
-  std::vector<BreakMark> near;
-  const double band = meanRadius(f);
-  for (const BreakMark& b : breaks) {
-    if (std::abs(b.position[1] - c[1]) < band) near.push_back(b);
-  }
-  addBreaks(r, near, 0.25 * band * kMm, true, (c[1] - 0.01 * band) * kMm);
+  sc.renderer->AddActor(particleActor(centres, radii, values, sc.lut, true));
+  addBreaks(sc.renderer, sc.nearMidPlane(breaks), 0.25 * sc.band * kMm, true,
+            (c[1] - 0.01 * sc.band) * kMm);
   const Bounds b = boundsOf(f);
   const double width = (b.hi[0] - b.lo[0]) * kMm;
-  addScaleBar(r, b.lo[0] * kMm, width, (c[1] - band) * kMm, b.lo[2] * kMm - 0.06 * width);
-  vtkCamera* cam = r->GetActiveCamera();
-  cam->ParallelProjectionOn();
-  cam->SetFocalPoint(c[0] * kMm, c[1] * kMm, c[2] * kMm);
-  cam->SetPosition(c[0] * kMm, c[1] * kMm - 1e3, c[2] * kMm);
-  cam->SetViewUp(0.0, 0.0, 1.0);
-  r->ResetCamera();
-  cam->Zoom(1.1);
-  decorate(r, lut, field,
-           title + ", section y = " + std::to_string(c[1] * kMm).substr(0, 6) + " mm",
-           !breaks.empty());
-  canvas.savePng(png);
+  addScaleBar(sc.renderer, b.lo[0] * kMm, width, (c[1] - sc.band) * kMm,
+              b.lo[2] * kMm - 0.06 * width);
+  sc.look({c[0] * kMm, c[1] * kMm, c[2] * kMm}, {c[0] * kMm, c[1] * kMm - 1e3, c[2] * kMm});
+  std::ostringstream where;
+  where.precision(4);
+  where << title << ", section y = " << c[1] * kMm << " mm";
+  decorate(sc.renderer, sc.lut, field, where.str(), !breaks.empty());
+  sc.canvas.savePng(png);
 }
 
 }  // namespace rocklab::reports

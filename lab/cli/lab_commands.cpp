@@ -57,7 +57,7 @@ class NotebookRecorder : public rigs::Recorder {
     if (level == "warning") std::cerr << "warning: " << text << "\n";
     w_.message(step, time, level, text);
   }
-    void stageTiming(std::string_view stage, double seconds, std::uint64_t calls) override {
+  void stageTiming(std::string_view stage, double seconds, std::uint64_t calls) override {
     w_.stageTiming(stage, seconds, calls);
   }
   void snapshot(std::string_view stage, std::string_view label, const Frame& frame) override {

@@ -48,7 +48,8 @@ Frame captureFrame(const Simulation<D>& sim) {
     f.bonds.push_back({P.slot_of[B.i[b]], P.slot_of[B.j[b]], B.load[b].fn, B.load[b].fs.norm()});
     f.bond_kind.push_back(B.kind[b]);
   }
-  for (const auto& w : sim.walls()) f.walls.push_back({w.name, three<D>(w.point), three<D>(w.normal)});
+  for (const auto& w : sim.walls())
+    f.walls.push_back({w.name, three<D>(w.point), three<D>(w.normal)});
   return f;
 }
 

@@ -257,7 +257,7 @@ Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report) {
   const double growth = std::log(1.0 / s0);
   const auto grow_steps = static_cast<std::uint64_t>(std::max(500.0, std::ceil(growth / 2e-4)));
   const double factor = std::exp(growth / static_cast<double>(grow_steps));
-    for (std::uint64_t k = 0; k < grow_steps; ++k) {
+  for (std::uint64_t k = 0; k < grow_steps; ++k) {
     sim.scaleRadii(factor);
     sim.step();
     if (spec.progress && k % 100 == 0) spec.progress(0.5 * static_cast<double>(k) / grow_steps);
@@ -269,7 +269,7 @@ Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report) {
   // Relax until the overlaps left by growth are gone (a loose target) or the packing is
   // in equilibrium (a target beyond jamming, where overlaps must stay).
   const std::uint64_t relax_max = 40000;
-    for (std::uint64_t k = 0; k < relax_max; k += 100) {
+  for (std::uint64_t k = 0; k < relax_max; k += 100) {
     sim.run(100);
     if (spec.progress) spec.progress(0.5 + 0.5 * static_cast<double>(k) / relax_max);
     if (sim.maxOverlapRatio() < 1e-3 || sim.unbalancedForceRatio() < 1e-3) break;

@@ -49,7 +49,7 @@ struct PackingSpec {
   std::array<double, 3> aspect{1, 1, 1};  // box edge ratios
   double thickness = 1.0;                 // m, 2D disk thickness
   std::uint64_t seed = 1;
-    double friction = 0.0;                  // -, during expansion (0 gives the densest packing)
+  double friction = 0.0;  // -, during expansion (0 gives the densest packing)
   int threads = 1;
   // Called now and then with the fraction done (at most 1); may throw to abandon the work.
   std::function<void(double)> progress;

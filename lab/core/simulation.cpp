@@ -868,8 +868,8 @@ std::vector<typename Simulation<D>::ContactForce> Simulation<D>::contactForces()
   if (!model_) return out;
   forEachTouching([&](const Touching& t) {
     if (t.wall) return;
-    out.push_back({t.i, t.j, model_->normalForce(t.mi, t.mj, t.overlap, t.shape),
-                   std::sqrt(t.shear2)});
+    out.push_back(
+        {t.i, t.j, model_->normalForce(t.mi, t.mj, t.overlap, t.shape), std::sqrt(t.shear2)});
   });
   return out;
 }

@@ -173,7 +173,7 @@ class Simulation {
   // Mean particle-particle contacts per particle, 2 C / N (overlap > 0; walls excluded).
   double coordinationNumber() const;
   std::size_t particleContacts() const;
-    // Largest overlap over the smaller radius, particle pairs and walls.
+  // Largest overlap over the smaller radius, particle pairs and walls.
   double maxOverlapRatio() const;
   // Touching particle pairs with their elastic normal force and tangential spring force.
   struct ContactForce {

@@ -142,7 +142,7 @@ CREATE TABLE messages (
 );
 CREATE INDEX messages_by_run ON messages (run_id, step);
 )sql",
-            // 2 -> 3: the protocol stage an event happened in.
+      // 2 -> 3: the protocol stage an event happened in.
       R"sql(
 ALTER TABLE events ADD COLUMN stage TEXT;
 )sql",
@@ -222,7 +222,7 @@ void Notebook::closeOrphanRuns() {
 }
 
 RunWriter::RunWriter(Notebook& nb, const RunInfo& info, const std::vector<ParamRow>& params)
-        : nb_(nb), started_(monotonicSeconds()), last_flush_(started_) {
+    : nb_(nb), started_(monotonicSeconds()), last_flush_(started_) {
   Connection& db = nb_.db();
   Transaction t(db);
   auto s = db.prepare(
@@ -255,8 +255,8 @@ void RunWriter::snapshot(std::string_view kind, std::string_view stage, std::str
   namespace fs = std::filesystem;
   const fs::path dir = nb_.runFilesDir(id_);
   fs::create_directories(dir);
-  const std::string name = std::string(stage) + "-" + std::to_string(step) + "." +
-                           std::string(extension);
+  const std::string name =
+      std::string(stage) + "-" + std::to_string(step) + "." + std::string(extension);
   const fs::path file = dir / name;
   {
     std::ofstream out(file.string() + ".partial", std::ios::binary | std::ios::trunc);
@@ -264,7 +264,7 @@ void RunWriter::snapshot(std::string_view kind, std::string_view stage, std::str
     if (!out) throw SqlError("cannot write '" + file.string() + "'");
   }
   fs::rename(file.string() + ".partial", file);
-    const std::string relative =
+  const std::string relative =
       fs::relative(fs::absolute(file), fs::absolute(nb_.path()).parent_path()).string();
   auto s = nb_.db().prepare(
       "INSERT INTO snapshots (run_id, step, time_s, stage, label, kind, path) "
@@ -308,11 +308,12 @@ void RunWriter::flush() {
       timings_.empty()) {
     return;
   }
-    last_flush_ = monotonicSeconds();
+  last_flush_ = monotonicSeconds();
   Connection& db = nb_.db();
   Transaction t(db);
   {
-    auto s = db.prepare("INSERT INTO series (run_id, name, step, time_s, value) VALUES (?, ?, ?, ?, ?)");
+    auto s =
+        db.prepare("INSERT INTO series (run_id, name, step, time_s, value) VALUES (?, ?, ?, ?, ?)");
     for (const Series& r : series_) {
       s.bind(1, id_).bind(2, r.name).bind(3, r.step).bind(4, r.time).bind(5, r.value).run();
     }

@@ -24,7 +24,7 @@ class Notebook {
  public:
   explicit Notebook(const std::string& path);
   Connection& db() { return *db_; }
-    const std::string& path() const { return db_->path(); }
+  const std::string& path() const { return db_->path(); }
   // Files of a run (snapshots, images) live beside the notebook, in <notebook>.files/run-N;
   // the notebook records them by paths relative to its own directory.
   std::string runFilesDir(std::int64_t run) const;
@@ -85,7 +85,7 @@ class RunWriter {
   void event(const EventRow& e);
   void message(std::uint64_t step, double time, std::string_view level, std::string_view text);
   void result(std::string_view name, double value, std::string_view unit);
-    void stageTiming(std::string_view stage, double seconds, std::uint64_t calls);
+  void stageTiming(std::string_view stage, double seconds, std::uint64_t calls);
   // Writes a file of the run (a state frame, kind "frame") and records it in `snapshots`.
   void snapshot(std::string_view kind, std::string_view stage, std::string_view label,
                 std::uint64_t step, double time, const std::string& bytes,
@@ -116,7 +116,7 @@ class RunWriter {
   };
   std::vector<Result> results_;
   std::vector<std::tuple<std::string, double, std::uint64_t>> timings_;
-    double started_ = 0.0;
+  double started_ = 0.0;
   double last_flush_ = 0.0;
   bool finished_ = false;
   void flushIfDue();

@@ -5,6 +5,21 @@
 
 namespace rocklab::notebook {
 
+namespace {
+
+Table drain(Statement& s) {
+  Table t;
+  for (int c = 0; c < s.columns(); ++c) t.columns.push_back(s.columnName(c));
+  while (s.step()) {
+    std::vector<Cell> row;
+    for (int c = 0; c < s.columns(); ++c) row.push_back(s.cell(c));
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+}  // namespace
+
 Table query(Notebook& nb, const std::string& sql) {
   Table t;
   t.rows = nb.db().query(sql, &t.columns);
@@ -45,8 +60,10 @@ std::vector<std::pair<std::string, Table>> showRun(Notebook& nb, std::int64_t ru
                          "SELECT stage, round(seconds, 3) AS seconds, calls FROM stage_timings "
                          "WHERE run_id = " +
                              id + " ORDER BY seconds DESC"));
-    out.emplace_back("snapshots", query(nb, "SELECT step, time_s, stage, label, kind, path FROM "
-                                          "snapshots WHERE run_id = " + id + " ORDER BY step"));
+  out.emplace_back("snapshots", query(nb,
+                                      "SELECT step, time_s, stage, label, kind, path FROM "
+                                      "snapshots WHERE run_id = " +
+                                          id + " ORDER BY step"));
   out.emplace_back("messages", query(nb,
                                      "SELECT step, time_s, level, text FROM messages WHERE "
                                      "run_id = " +
@@ -74,14 +91,7 @@ Table seriesOf(Notebook& nb, std::int64_t run, const std::vector<std::string>& n
   sql += " ORDER BY name, step";
   auto s = nb.db().prepare(sql);
   for (std::size_t k = 0; k < names.size(); ++k) s.bind(static_cast<int>(k + 1), names[k]);
-  Table t;
-  for (int c = 0; c < s.columns(); ++c) t.columns.push_back(s.columnName(c));
-  while (s.step()) {
-    std::vector<Cell> row;
-    for (int c = 0; c < s.columns(); ++c) row.push_back(s.cell(c));
-    t.rows.push_back(std::move(row));
-  }
-  return t;
+  return drain(s);
 }
 
 Table eventsOf(Notebook& nb, std::int64_t run, const std::string& kind) {
@@ -90,14 +100,7 @@ Table eventsOf(Notebook& nb, std::int64_t run, const std::string& kind) {
       "SELECT step, time_s, stage, kind, mode, x, y, z, particle_a, particle_b, granular, value "
       "FROM events WHERE run_id = ? AND (? = '' OR kind = ?) ORDER BY step, rowid");
   s.bind(1, run).bind(2, kind).bind(3, kind);
-  Table t;
-  for (int c = 0; c < s.columns(); ++c) t.columns.push_back(s.columnName(c));
-  while (s.step()) {
-    std::vector<Cell> row;
-    for (int c = 0; c < s.columns(); ++c) row.push_back(s.cell(c));
-    t.rows.push_back(std::move(row));
-  }
-  return t;
+  return drain(s);
 }
 
 namespace {

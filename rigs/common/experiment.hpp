@@ -30,7 +30,7 @@ class Recorder {
   virtual void result(std::string_view name, double value, std::string_view unit) = 0;
   virtual void message(std::uint64_t step, double time, std::string_view level,
                        std::string_view text) = 0;
-    virtual void stageTiming(std::string_view stage, double seconds, std::uint64_t calls) = 0;
+  virtual void stageTiming(std::string_view stage, double seconds, std::uint64_t calls) = 0;
   // A frame of the state for reports and ParaView (`label` says which moment it is).
   virtual void snapshot(std::string_view stage, std::string_view label, const Frame& frame) = 0;
 };

@@ -1,5 +1,6 @@
 #include "rigs/common/specimen.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -100,8 +101,8 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
         true);
   range(s.integer("numerics.threads", 1, "OpenMP threads; results do not depend on it"), 1, false,
         1024, false);
-    range(s.real("numerics.skin_ratio", "-", 1, 0.2, "Verlet skin over the mean radius"), 0, true,
-        10, false);
+  range(s.real("numerics.skin_ratio", "-", 1, 0.2, "Verlet skin over the mean radius"), 0, true, 10,
+        false);
   range(s.real("numerics.overlap_limit", "-", 1, 0.25,
                "the run stops when an overlap exceeds this fraction of the smaller radius"),
         0, true, 1, false);
@@ -119,7 +120,7 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
                "warn when the inertial number of a loading stage exceeds this"),
         0, true, 10, false);
 
-    range(s.integer("output.record_every_steps", 500, "steps between recorded measurements"), 1,
+  range(s.integer("output.record_every_steps", 500, "steps between recorded measurements"), 1,
         false, 1e9, false);
   s.flag("output.snapshots", true,
          "save frames of the state (particles, contacts, bonds, walls) when the sample is "
@@ -266,7 +267,7 @@ Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
   spec.aspect[D - 1] = s.real("sample.aspect_axial");
   spec.thickness = s.real("sample.thickness_m");
   spec.seed = static_cast<std::uint64_t>(s.integer("protocol.seed"));
-    spec.threads = static_cast<int>(s.integer("numerics.threads"));
+  spec.threads = static_cast<int>(s.integer("numerics.threads"));
   spec.progress = [&](double f) { control.tick("packing", 0, f, "radius expansion"); };
   const Packing<D> p = generatePacking<D>(spec);
 
@@ -274,13 +275,13 @@ Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
   sp.mean_radius =
       std::accumulate(p.radii.begin(), p.radii.end(), 0.0) / static_cast<double>(p.radii.size());
   sp.density = s.real("material.density_kg_per_m3");
-    sp.record_every = static_cast<std::uint64_t>(s.integer("output.record_every_steps"));
+  sp.record_every = static_cast<std::uint64_t>(s.integer("output.record_every_steps"));
   sp.snapshot_every = static_cast<std::uint64_t>(s.integer("output.snapshot_every_steps"));
   SimulationConfig cfg;
   cfg.contact_law = s.text("material.contact_law");
   cfg.skin = s.real("numerics.skin_ratio") * sp.mean_radius;
   cfg.local_damping = s.real("numerics.local_damping");
-    cfg.timestep.safety = s.real("numerics.timestep_safety");
+  cfg.timestep.safety = s.real("numerics.timestep_safety");
   cfg.guard.overlap_limit = s.real("numerics.overlap_limit");
   cfg.threads = spec.threads;
   cfg.track_energy = true;
@@ -349,7 +350,7 @@ void formAndCement(Specimen<D>& sp, const Settings& s, Recorder& rec, RunControl
                     " strength draws <= 0 left uncemented (bonds.negative_strength = " +
                     s.text("bonds.negative_strength") + ")");
   }
-    sim.restartEnergyLedger();
+  sim.restartEnergyLedger();
   sp.frame->resetReference();
   sp.resetBrokenCount();
   snapshot(sp, s, rec, "formation", "formed");
@@ -392,6 +393,24 @@ void servoTo(Specimen<D>& sp, const Settings& s, double axial, double lateral, d
   }
   for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, to[a], 0.0});
   settle(sp, s, stage, rec, control);
+}
+
+template <int D>
+void recordTimings(Recorder& rec, const std::vector<const Simulation<D>*>& sims) {
+  std::vector<StageTiming> total;
+  for (const auto* sim : sims) {
+    for (const StageTiming& t : sim->stageTimings()) {
+      auto it = std::find_if(total.begin(), total.end(),
+                             [&](const StageTiming& x) { return x.name == t.name; });
+      if (it == total.end()) {
+        total.push_back(t);
+      } else {
+        it->seconds += t.seconds;
+        it->calls += t.calls;
+      }
+    }
+  }
+  for (const StageTiming& t : total) rec.stageTiming(t.name, t.seconds, t.calls);
 }
 
 template <int D>
@@ -476,6 +495,8 @@ template void snapshot<3>(Specimen<3>&, const Settings&, Recorder&, const std::s
                           const std::string&);
 template void recordBreaks<3>(Specimen<3>&, Recorder&, const std::string&);
 template double inertialNumber<2>(const Specimen<2>&, double);
+template void recordTimings<2>(Recorder&, const std::vector<const Simulation<2>*>&);
+template void recordTimings<3>(Recorder&, const std::vector<const Simulation<3>*>&);
 template double inertialNumber<3>(const Specimen<3>&, double);
 
 }  // namespace rocklab::rigs

@@ -28,7 +28,7 @@ struct Specimen {
   double density = 0.0;      // kg/m^3
   std::uint8_t cement_kind = 0;
   CementReport cement;
-    std::uint64_t record_every = 500;
+  std::uint64_t record_every = 500;
   std::uint64_t snapshot_every = 0;  // 0: only at the ends of stages
   // Bonds broken before the measured stage (formation, coring) are not counted in it.
   std::uint64_t broken_offset[2] = {0, 0};
@@ -69,6 +69,10 @@ void recordBreaks(Specimen<D>& sp, Recorder& rec, const std::string& stage);
 template <int D>
 void snapshot(Specimen<D>& sp, const Settings& s, Recorder& rec, const std::string& stage,
               const std::string& label);
+
+// The stage timings of the simulations an experiment ran (branches summed), to the recorder.
+template <int D>
+void recordTimings(Recorder& rec, const std::vector<const Simulation<D>*>& sims);
 
 // The inertial number I = edot d sqrt(rho / p) of the present loading: below about 1e-3 a
 // granular test is quasi-static (GDR MiDi 2004; da Cruz et al. 2005).

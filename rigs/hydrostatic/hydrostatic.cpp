@@ -42,7 +42,7 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
 
   // The ramp up and the hold at the peak are recorded as series (stresses, volumetric
   // strain, porosity, broken bonds) under the stage names.
-    servoTo(sp, s, s.si("loading.stress_max_MPa"), s.si("loading.stress_max_MPa"), rate, "loading",
+  servoTo(sp, s, s.si("loading.stress_max_MPa"), s.si("loading.stress_max_MPa"), rate, "loading",
           rec, control);
   snapshot(sp, s, rec, "loading", "peak");
   rec.result("mean_stress_peak_MPa", frame.meanStress() / 1e6, "MPa");
@@ -56,10 +56,10 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   if (s.real("loading.unload_to_MPa") > 0.0) {
     servoTo(sp, s, s.si("loading.unload_to_MPa"), s.si("loading.unload_to_MPa"), rate, "unloading",
             rec, control);
-        rec.result("volumetric_strain_after_unloading", frame.volumetricStrain(), "");
+    rec.result("volumetric_strain_after_unloading", frame.volumetricStrain(), "");
     snapshot(sp, s, rec, "unloading", "final");
   }
-  for (const StageTiming& t : sp.sim->stageTimings()) rec.stageTiming(t.name, t.seconds, t.calls);
+  recordTimings<D>(rec, {sp.sim.get()});
 }
 
 }  // namespace

@@ -174,13 +174,13 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
       phase = 0;
       ++next_cycle;
     }
-        const bool finished = strain_control ? strain >= strain_max : stress >= stress_max;
+    const bool finished = strain_control ? strain >= strain_max : stress >= stress_max;
     if (finished) {
       record();
       snapshot(sp, s, rec, stage, "final");
       break;
     }
-        if ((sim.steps() - start) % sp.record_every == 0) record();
+    if ((sim.steps() - start) % sp.record_every == 0) record();
     if (sp.snapshot_every && (sim.steps() - start) % sp.snapshot_every == 0) {
       snapshot(sp, s, rec, stage, "step " + std::to_string(sim.steps() - start));
     }
@@ -258,24 +258,6 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
                     "loading.axial_strain_rate_per_s");
   }
   return e0;
-}
-
-template <int D>
-void recordTimings(Recorder& rec, const std::vector<const Simulation<D>*>& sims) {
-  std::vector<StageTiming> total;
-  for (const auto* sim : sims) {
-    for (const StageTiming& t : sim->stageTimings()) {
-      auto it = std::find_if(total.begin(), total.end(),
-                             [&](const StageTiming& x) { return x.name == t.name; });
-      if (it == total.end()) {
-        total.push_back(t);
-      } else {
-        it->seconds += t.seconds;
-        it->calls += t.calls;
-      }
-    }
-  }
-  for (const StageTiming& t : total) rec.stageTiming(t.name, t.seconds, t.calls);
 }
 
 template <int D>

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/e2e/command.hpp"
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -19,13 +21,9 @@ struct Result {
 };
 
 Result run(const std::string& args) {
-  const std::string cmd = std::string(ROCKLAB_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = pclose(pipe);
-  return {WEXITSTATUS(status), out};
+  Result r;
+  r.status = rocklab::testing::runRocklab(args, &r.out);
+  return r;
 }
 
 std::string tempPath(const std::string& name) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/e2e/command.hpp"
+
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -39,17 +41,6 @@ struct Lab {
   }
 };
 
-int runCommand(const std::string& args, std::string* out = nullptr) {
-  const std::string cmd = std::string(ROCKLAB_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string text;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), pipe)) text += buf.data();
-  const int status = pclose(pipe);
-  if (out) *out = text;
-  return WEXITSTATUS(status);
-}
-
 double result(nb::Notebook& n, const std::string& name) {
   const auto t = nb::query(n, "SELECT value FROM results WHERE name = '" + name + "'");
   EXPECT_EQ(t.rows.size(), 1u) << name;
@@ -64,11 +55,11 @@ std::string scalar(nb::Notebook& n, const std::string& sql) {
 TEST(QuickProtocols, OedometerFormedUnderStressShowsFigures1And2) {
   Lab lab("oedometer");
   std::string out;
-  ASSERT_EQ(runCommand("run " + sourceDir() +
-                           "/protocols/oedometer-formed-under-stress-quick.toml"
-                           " --quiet --threads 1 --lab " +
-                           lab.path,
-                       &out),
+  ASSERT_EQ(rocklab::testing::runRocklab("run " + sourceDir() +
+                                             "/protocols/oedometer-formed-under-stress-quick.toml"
+                                             " --quiet --threads 1 --lab " +
+                                             lab.path,
+                                         &out),
             0)
       << out;
   nb::Notebook n(lab.path);
@@ -86,7 +77,7 @@ TEST(QuickProtocols, OedometerFormedUnderStressShowsFigures1And2) {
   EXPECT_GT(result(n, "stress_path_slope_final"), 1.5 * result(n, "stress_path_slope_initial"));
   // The lateral stress rises slowly at first: below the elastic K0 of the formation state.
   EXPECT_LT(result(n, "stress_path_slope_initial"), 0.25);
-    // An early cycle is nearly elastic, a late one markedly plastic (loading tangent over
+  // An early cycle is nearly elastic, a late one markedly plastic (loading tangent over
   // unloading secant: measured 0.91 at 0.05% strain, 0.67 at 2%; 1 is elastic).
   EXPECT_GT(result(n, "cycle1_modulus_ratio"), 0.85);
   EXPECT_LT(result(n, "cycle2_modulus_ratio"), result(n, "cycle1_modulus_ratio") - 0.15);
@@ -111,11 +102,11 @@ TEST(QuickProtocols, OedometerFormedUnderStressShowsFigures1And2) {
 TEST(QuickProtocols, CoredSampleIsSofterAtFirstThanTheVirgin) {
   Lab lab("coring");
   std::string out;
-  ASSERT_EQ(runCommand("run " + sourceDir() +
-                           "/protocols/oedometer-core-damage-quick.toml"
-                           " --quiet --threads 1 --lab " +
-                           lab.path,
-                       &out),
+  ASSERT_EQ(rocklab::testing::runRocklab("run " + sourceDir() +
+                                             "/protocols/oedometer-core-damage-quick.toml"
+                                             " --quiet --threads 1 --lab " +
+                                             lab.path,
+                                         &out),
             0)
       << out;
   nb::Notebook n(lab.path);
@@ -133,11 +124,11 @@ TEST(QuickProtocols, CoredSampleIsSofterAtFirstThanTheVirgin) {
 TEST(QuickProtocols, HydrostaticCellRuns) {
   Lab lab("hydrostatic");
   std::string out;
-  ASSERT_EQ(
-      runCommand("run " + sourceDir() +
-                     "/protocols/hydrostatic-quick.toml --quiet --threads 1 --lab " + lab.path,
-                 &out),
-      0)
+  ASSERT_EQ(rocklab::testing::runRocklab(
+                "run " + sourceDir() +
+                    "/protocols/hydrostatic-quick.toml --quiet --threads 1 --lab " + lab.path,
+                &out),
+            0)
       << out;
   nb::Notebook n(lab.path);
   EXPECT_NEAR(result(n, "mean_stress_peak_MPa"), 60.0, 0.6);
@@ -174,11 +165,15 @@ TEST(Protocols, FastLoadingIsFlaggedAsNotQuasiStatic) {
       "fast", std::string("[protocol]\nname = \"fast\"\nrig = \"oedometer\"\n") + kSmallSample +
                   "[loading]\naxial_strain_rate_per_s = 3000\naxial_strain_max = 0.01\n");
   std::string out;
-  ASSERT_EQ(runCommand("run " + file + " --quiet --threads 1 --lab " + lab.path, &out), 0) << out;
+  ASSERT_EQ(
+      rocklab::testing::runRocklab("run " + file + " --quiet --threads 1 --lab " + lab.path, &out),
+      0)
+      << out;
   EXPECT_NE(out.find("warning: loading was not quasi-static"), std::string::npos) << out;
   nb::Notebook n(lab.path);
-  EXPECT_NE(scalar(n, "SELECT count(*) FROM messages WHERE level = 'warning' AND text LIKE "
-                      "'%not quasi-static%'"),
+  EXPECT_NE(scalar(n,
+                   "SELECT count(*) FROM messages WHERE level = 'warning' AND text LIKE "
+                   "'%not quasi-static%'"),
             "0");
   EXPECT_GT(result(n, "max_inertial_number"), 1e-3);
   std::filesystem::remove(file);
@@ -193,7 +188,10 @@ TEST(Protocols, DisksUnderAStressRamp) {
                    "[loading]\ncontrol = \"stress_ramp\"\naxial_stress_rate_MPa_per_s = 20000\n"
                    "axial_stress_max_MPa = 40\n");
   std::string out;
-  ASSERT_EQ(runCommand("run " + file + " --quiet --threads 1 --lab " + lab.path, &out), 0) << out;
+  ASSERT_EQ(
+      rocklab::testing::runRocklab("run " + file + " --quiet --threads 1 --lab " + lab.path, &out),
+      0)
+      << out;
   nb::Notebook n(lab.path);
   EXPECT_NEAR(result(n, "axial_stress_final_MPa"), 40.0, 0.5);
   EXPECT_GT(result(n, "axial_strain_final"), 0.0);
@@ -215,16 +213,17 @@ TEST(Protocols, InvalidProtocolWritesNothing) {
     std::fclose(f);
   }
   std::string out;
-  EXPECT_EQ(runCommand("run " + bad.string() + " --lab " + lab.path, &out), 2);
+  EXPECT_EQ(rocklab::testing::runRocklab("run " + bad.string() + " --lab " + lab.path, &out), 2);
   EXPECT_NE(out.find(bad.string() + ":7: formation.axial_stress_MPa = -30 is outside the allowed "
                                     "range (0, 10000] (MPa)"),
             std::string::npos)
       << out;
   EXPECT_FALSE(std::filesystem::exists(lab.path));
-  EXPECT_EQ(runCommand("check " + bad.string(), &out), 2);
+  EXPECT_EQ(rocklab::testing::runRocklab("check " + bad.string(), &out), 2);
   std::filesystem::remove(bad);
-  EXPECT_EQ(
-      runCommand("check " + sourceDir() + "/protocols/oedometer-formed-under-stress.toml", &out), 0)
+  EXPECT_EQ(rocklab::testing::runRocklab(
+                "check " + sourceDir() + "/protocols/oedometer-formed-under-stress.toml", &out),
+            0)
       << out;
 }
 
@@ -254,24 +253,29 @@ TEST(Protocols, SigtermLeavesAnInterruptedRunWithItsData) {
 TEST(Protocols, NotebookCommandsQueryTheLab) {
   Lab lab("queries");
   std::string out;
-  ASSERT_EQ(
-      runCommand("run " + sourceDir() +
-                     "/protocols/hydrostatic-quick.toml --quiet --threads 1 --lab " + lab.path,
-                 &out),
-      0)
+  ASSERT_EQ(rocklab::testing::runRocklab(
+                "run " + sourceDir() +
+                    "/protocols/hydrostatic-quick.toml --quiet --threads 1 --lab " + lab.path,
+                &out),
+            0)
       << out;
-  EXPECT_EQ(runCommand("notebook runs --lab " + lab.path, &out), 0);
+  EXPECT_EQ(rocklab::testing::runRocklab("notebook runs --lab " + lab.path, &out), 0);
   EXPECT_NE(out.find("hydrostatic-quick"), std::string::npos) << out;
-  EXPECT_EQ(runCommand("notebook show 1 --lab " + lab.path, &out), 0);
+  EXPECT_EQ(rocklab::testing::runRocklab("notebook show 1 --lab " + lab.path, &out), 0);
   EXPECT_NE(out.find("secant_bulk_modulus_MPa"), std::string::npos) << out;
-  EXPECT_EQ(runCommand("notebook series 1 loading.porosity --csv --lab " + lab.path, &out), 0);
+  EXPECT_EQ(rocklab::testing::runRocklab(
+                "notebook series 1 loading.porosity --csv --lab " + lab.path, &out),
+            0);
   EXPECT_EQ(out.rfind("name,step,time_s,value\nloading.porosity,", 0), 0u) << out.substr(0, 200);
-  EXPECT_EQ(runCommand("notebook events 1 --kind bond_break --csv --lab " + lab.path, &out), 0);
+  EXPECT_EQ(rocklab::testing::runRocklab(
+                "notebook events 1 --kind bond_break --csv --lab " + lab.path, &out),
+            0);
   EXPECT_NE(out.find("bond_break"), std::string::npos);
-  EXPECT_EQ(runCommand("notebook sql \"SELECT count(*) AS n FROM runs\" --lab " + lab.path, &out),
+  EXPECT_EQ(rocklab::testing::runRocklab(
+                "notebook sql \"SELECT count(*) AS n FROM runs\" --lab " + lab.path, &out),
             0);
   EXPECT_EQ(out, "n\n1\n");
-  EXPECT_NE(runCommand("notebook show 7 --lab " + lab.path, &out), 0);
+  EXPECT_NE(rocklab::testing::runRocklab("notebook show 7 --lab " + lab.path, &out), 0);
   EXPECT_NE(out.find("no run 7"), std::string::npos) << out;
 }
 

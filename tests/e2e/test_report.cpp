@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/e2e/command.hpp"
+
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPNGReader.h>
@@ -24,17 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int runCommand(const std::string& args, std::string* out) {
-  const std::string cmd = std::string(ROCKLAB_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string text;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), pipe)) text += buf.data();
-  const int status = pclose(pipe);
-  *out = text;
-  return WEXITSTATUS(status);
-}
-
 class Report : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -48,7 +39,9 @@ class Report : public ::testing::Test {
          "porosity_initial = 0.42\n[formation]\naxial_stress_MPa = 10\nlateral_stress_MPa = 5\n"
          "[loading]\naxial_strain_max = 0.005\ncycle_at_axial_strain = [0.002]\n";
   }
-  void TearDown() override { if (!getenv("KEEP")) fs::remove_all(dir_); }
+  void TearDown() override {
+    if (!getenv("KEEP")) fs::remove_all(dir_);
+  }
   fs::path dir_;
   std::string lab_;
 };
@@ -72,13 +65,14 @@ TEST_F(Report, TwoRunsOverlaidWithSnapshotsAndParaViewExport) {
   std::string out;
   for (int k = 0; k < 2; ++k) {
     ASSERT_EQ(
-        runCommand("run " + (dir_ / "small.toml").string() + " --quiet --threads 1 --lab " + lab_,
-                   &out),
+        rocklab::testing::runRocklab(
+            "run " + (dir_ / "small.toml").string() + " --quiet --threads 1 --lab " + lab_, &out),
         0)
         << out;
   }
   const std::string rep = (dir_ / "report").string();
-  ASSERT_EQ(runCommand("report 1 2 --lab " + lab_ + " --out " + rep, &out), 0) << out;
+  ASSERT_EQ(rocklab::testing::runRocklab("report 1 2 --lab " + lab_ + " --out " + rep, &out), 0)
+      << out;
   std::ifstream in(rep + "/index.html");
   const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   // Every file the page references exists, and the figures are not blank.
@@ -111,7 +105,8 @@ TEST_F(Report, TwoRunsOverlaidWithSnapshotsAndParaViewExport) {
 
   // ParaView export: one .vtp per frame and part, a .pvd, counts as recorded.
   const std::string vtk = (dir_ / "vtk").string();
-  ASSERT_EQ(runCommand("export 1 --vtk " + vtk + " --lab " + lab_, &out), 0) << out;
+  ASSERT_EQ(rocklab::testing::runRocklab("export 1 --vtk " + vtk + " --lab " + lab_, &out), 0)
+      << out;
   EXPECT_TRUE(fs::exists(vtk + "/run1.pvd"));
   rocklab::notebook::Notebook nb(lab_);
   const auto frames =
@@ -134,7 +129,9 @@ TEST_F(Report, TwoRunsOverlaidWithSnapshotsAndParaViewExport) {
 
 TEST_F(Report, MissingRunsAndLabsAreRefused) {
   std::string out;
-  EXPECT_NE(runCommand("report 1 --lab " + lab_ + " --out " + (dir_ / "r").string(), &out), 0);
+  EXPECT_NE(rocklab::testing::runRocklab(
+                "report 1 --lab " + lab_ + " --out " + (dir_ / "r").string(), &out),
+            0);
   EXPECT_NE(out.find("no lab notebook"), std::string::npos) << out;
 }
 

@@ -47,8 +47,8 @@ TEST_F(NotebookTest, NewNotebookHasTheSchemaWalAndForeignKeys) {
   EXPECT_EQ(nb.db().userVersion(), kSchemaVersion);
   EXPECT_EQ(scalar(nb, "PRAGMA journal_mode"), "wal");
   EXPECT_EQ(scalar(nb, "PRAGMA foreign_keys"), "1");
-    for (const char* t :
-       {"runs", "params", "series", "events", "stage_timings", "results", "messages", "snapshots"}) {
+  for (const char* t : {"runs", "params", "series", "events", "stage_timings", "results",
+                        "messages", "snapshots"}) {
     EXPECT_EQ(
         scalar(nb, std::string("SELECT count(*) FROM sqlite_master WHERE name = '") + t + "'"), "1")
         << t;
@@ -96,7 +96,8 @@ TEST_F(NotebookTest, SnapshotFilesLiveBesideTheNotebookAndAreRecorded) {
   w.snapshot("frame", "loading", "final", 1234, 0.5, std::string("abc\0def", 7), "rkf");
   w.finish(RunStatus::Completed);
   const std::string rel = scalar(nb, "SELECT path FROM snapshots");
-  EXPECT_EQ(rel, std::filesystem::path(path_).filename().string() + ".files/run-1/loading-1234.rkf");
+  EXPECT_EQ(rel,
+            std::filesystem::path(path_).filename().string() + ".files/run-1/loading-1234.rkf");
   std::ifstream in(nb.resolve(rel), std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_EQ(bytes, std::string("abc\0def", 7));
@@ -128,7 +129,7 @@ TEST_F(NotebookTest, LargeRunsAreWrittenInBatchesWhileRunning) {
   Notebook nb(path_);
   RunWriter w(nb, info(), {});
   for (int k = 0; k < 50000; ++k) w.series("s", k, k, k);
-    // A second connection, as another process would, already sees the committed batches
+  // A second connection, as another process would, already sees the committed batches
   // (every 20,000 rows; more if a batch also came of age, as under sanitizers).
   Notebook other(path_);
   EXPECT_GE(std::stoi(scalar(other, "SELECT count(*) FROM series")), 40000);
@@ -147,9 +148,9 @@ TEST_F(NotebookTest, OldSchemaIsMigratedAndNewerRefused) {
   }
   {
     Notebook nb(path_);
-        EXPECT_EQ(nb.db().userVersion(), kSchemaVersion);
+    EXPECT_EQ(nb.db().userVersion(), kSchemaVersion);
     EXPECT_EQ(scalar(nb, "SELECT protocol FROM runs"), "p");
-        EXPECT_EQ(scalar(nb, "SELECT count(*) FROM messages"), "0");
+    EXPECT_EQ(scalar(nb, "SELECT count(*) FROM messages"), "0");
     EXPECT_EQ(scalar(nb, "SELECT count(*) FROM events WHERE stage IS NULL"), "0");
   }
   {
