@@ -102,11 +102,6 @@ double Packing<D>::solidVolume() const {
   return v;
 }
 
-namespace {
-
-// Random sequential placement: each particle (largest first) at the first of a few
-// hundred random spots where it overlaps nothing placed before; if none is free it takes
-// the least overlapping spot and the expansion pushes the overlap apart.
 template <int D>
 std::vector<Vec<D>> placeRandomly(const std::vector<double>& r, const Vec<D>& lo, const Vec<D>& hi,
                                   Rng& rng) {
@@ -166,8 +161,6 @@ std::vector<Vec<D>> placeRandomly(const std::vector<double>& r, const Vec<D>& lo
   }
   return x;
 }
-
-}  // namespace
 
 template <int D>
 Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report) {
@@ -288,6 +281,10 @@ Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report) {
 
 template struct Packing<2>;
 template struct Packing<3>;
+template std::vector<Vec<2>> placeRandomly<2>(const std::vector<double>&, const Vec<2>&,
+                                              const Vec<2>&, Rng&);
+template std::vector<Vec<3>> placeRandomly<3>(const std::vector<double>&, const Vec<3>&,
+                                              const Vec<3>&, Rng&);
 template Packing<2> generatePacking<2>(const PackingSpec&, PackingReport*);
 template Packing<3> generatePacking<3>(const PackingSpec&, PackingReport*);
 

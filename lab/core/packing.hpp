@@ -75,6 +75,13 @@ struct PackingReport {
   double unbalanced = 0.0;    // unbalanced force ratio at the end
 };
 
+// Random sequential placement in the box [lo, hi]: each sphere (largest first) at the
+// first of a few hundred random spots where it overlaps nothing placed before; if none is
+// free it takes the least overlapping spot (an expansion then pushes the overlap apart).
+template <int D>
+std::vector<Vec<D>> placeRandomly(const std::vector<double>& r, const Vec<D>& lo, const Vec<D>& hi,
+                                  Rng& rng);
+
 template <int D>
 Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report = nullptr);
 

@@ -40,6 +40,8 @@ ParticleId ParticleStore<D>::add(const ParticleSpec<D>& spec) {
   radius.push_back(spec.radius);
   material.push_back(spec.material);
   groups.push_back(spec.groups);
+  cluster.push_back(spec.cluster);
+  body.push_back(kNoBody);
   slot_of.push_back(slot);
   return {slot, slot_generation_[slot]};
 }
@@ -64,7 +66,7 @@ void ParticleStore<D>::remove(ParticleId id) {
   if (i != last) slot_index_[slot_of[last]] = static_cast<std::uint32_t>(i);
   move_last(pos), move_last(vel), move_last(force), move_last(spin), move_last(torque);
   move_last(inv_mass), move_last(inv_inertia), move_last(radius), move_last(material);
-  move_last(groups), move_last(slot_of);
+  move_last(groups), move_last(cluster), move_last(body), move_last(slot_of);
   slot_index_[id.slot] = kNoIndex;
   ++slot_generation_[id.slot];
   free_slots_.push_back(id.slot);
@@ -80,7 +82,7 @@ void ParticleStore<D>::permute(const std::vector<std::uint32_t>& order) {
   };
   apply(pos), apply(vel), apply(force), apply(spin), apply(torque);
   apply(inv_mass), apply(inv_inertia), apply(radius), apply(material), apply(groups);
-  apply(slot_of);
+  apply(cluster), apply(body), apply(slot_of);
   for (std::size_t k = 0; k < slot_of.size(); ++k) {
     slot_index_[slot_of[k]] = static_cast<std::uint32_t>(k);
   }

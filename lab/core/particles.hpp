@@ -20,6 +20,10 @@ struct ParticleId {
   friend bool operator==(const ParticleId&, const ParticleId&) = default;
 };
 
+// No rigid body (clump) or grain (cluster): the particle is on its own.
+inline constexpr std::uint32_t kNoBody = 0xffffffffu;
+inline constexpr std::uint32_t kNoCluster = 0xffffffffu;
+
 class StaleParticleId : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -35,6 +39,9 @@ struct ParticleSpec {
   bool fixed = false;    // infinite mass and inertia: moves only if its velocity is prescribed
   std::uint16_t material = 0;
   std::uint32_t groups = 0;  // bit mask of user group tags
+  // The breakable grain (cluster) the particle belongs to: intragranular bonds join
+  // particles of one cluster, intergranular bonds particles of different ones.
+  std::uint32_t cluster = kNoCluster;
 };
 
 template <int D>
@@ -51,6 +58,10 @@ class ParticleStore {
 
   // Cold metadata.
   std::vector<std::uint32_t> groups;
+  std::vector<std::uint32_t> cluster;  // grain id or kNoCluster
+  // The clump (rigid body) the particle is a pebble of, or kNoBody. Set by the simulation;
+  // a pebble moves with its body and is skipped by the particle integration.
+  std::vector<std::uint32_t> body;
   std::vector<std::uint32_t> slot_of;  // index -> slot
 
   // 2D particles are disks extruded to this thickness (m); ignored in 3D.
@@ -86,7 +97,8 @@ class ParticleStore {
     ar("thickness", thickness);
     ar("pos", pos), ar("vel", vel), ar("force", force), ar("spin", spin), ar("torque", torque);
     ar("inv_mass", inv_mass), ar("inv_inertia", inv_inertia), ar("radius", radius);
-    ar("material", material), ar("groups", groups), ar("slot_of", slot_of);
+    ar("material", material), ar("groups", groups), ar("cluster", cluster);
+    ar("body", body), ar("slot_of", slot_of);
     ar("slot_index", slot_index_), ar("slot_generation", slot_generation_);
     ar("free_slots", free_slots_);
   }

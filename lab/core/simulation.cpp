@@ -1,10 +1,12 @@
 #include "lab/core/simulation.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 
 #include "lab/core/archive.hpp"
@@ -74,6 +76,22 @@ std::uint64_t pairKey(std::uint32_t a, std::uint32_t b) {
   return a < b ? (std::uint64_t{a} << 32 | b) : (std::uint64_t{b} << 32 | a);
 }
 
+// Removes candidate pairs of two pebbles of one clump: a rigid body has no inner contacts.
+void dropPairsWithinBodies(const std::vector<std::uint32_t>& body, PairRows& pairs) {
+  std::uint32_t out = 0, begin = 0;
+  for (std::size_t i = 0; i + 1 < pairs.row.size(); ++i) {
+    const std::uint32_t end = pairs.row[i + 1];
+    for (std::uint32_t p = begin; p < end; ++p) {
+      const std::uint32_t j = pairs.col[p];
+      if (body[i] != kNoBody && body[i] == body[j]) continue;
+      pairs.col[out++] = j;
+    }
+    begin = end;
+    pairs.row[i + 1] = out;
+  }
+  pairs.col.resize(out);
+}
+
 struct OverrideRow {
   std::uint16_t a = 0, b = 0;
   double friction = NAN, damping_ratio = NAN;  // NaN: not overridden
@@ -116,8 +134,18 @@ void Simulation<D>::scaleRadii(double factor) {
     r *= factor;
     rmax = std::max(rmax, r);
   }
+  // Clumps grow about their centroids: the pebbles move apart with them.
+  double reach = 0.0;
+  for (std::uint32_t c = 0; c < clumps_.size(); ++c) {
+    if (!clumps_.alive[c]) continue;
+    for (std::uint32_t k = clumps_.first[c]; k < clumps_.first[c + 1]; ++k) {
+      clumps_.member_offset[k] *= factor;
+      reach = std::max(reach, clumps_.member_offset[k].norm());
+    }
+    placePebbles(c, true);
+  }
   if (factor < 1.0) return;  // shrinking never brings surfaces closer
-  contacts_.radius_growth += (factor - 1.0) / factor * rmax;
+  contacts_.radius_growth += (factor - 1.0) / factor * (rmax + reach);
 }
 
 template <int D>
@@ -203,6 +231,9 @@ void Simulation<D>::prepare() {
     for (auto& f : particles_.force) f.setZero();
     for (auto& t : particles_.torque) t = angZero<A>();
     computeForces(0.0);
+    for (std::uint32_t c = 0; c < clumps_.size(); ++c) {
+      if (clumps_.alive[c]) gatherClumpLoad(c);
+    }
     for (std::size_t w = 0; w < walls_.size(); ++w) wall_prev_force_[w] = walls_[w].force;
     forces_valid_ = true;
   }
@@ -249,7 +280,7 @@ bool Simulation<D>::computeForces(double history_dt) {
     };
     const double dt = history_dt;
     const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
-      if (P.inv_mass[i] == 0.0) return;
+      if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) return;  // clumps: whole bodies
       const V f = g / P.inv_mass[i];
       P.force[i] += f;
       a.work += f.dot(P.vel[i]) * dt;  // exact over the drift x += v dt
@@ -365,6 +396,10 @@ CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
       const double gap = (P.pos[j] - P.pos[i]).norm() - P.radius[i] - P.radius[j];
       const double rmin = std::min(P.radius[i], P.radius[j]);
       if (gap >= gap_ratio * rmin) continue;
+      if (P.body[i] != kNoBody && P.body[i] == P.body[j]) continue;  // one rigid body
+      // Intragranular bonds join particles of one grain, intergranular bonds the others.
+      const bool same_grain = P.cluster[i] != kNoCluster && P.cluster[i] == P.cluster[j];
+      if (same_grain != kind.intragranular) continue;
       ++report.candidates;
       if (std::binary_search(existing.begin(), existing.end(), std::uint64_t{i} << 32 | j)) {
         continue;
@@ -404,7 +439,9 @@ void Simulation<D>::initialIntegrate() {
     double vmax2 = 0.0;
     void merge(const Acc& o) { vmax2 = std::max(vmax2, o.vmax2); }
   };
+  const bool clumped = hasClumps();
   const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
+    if (clumped && P.body[i] != kNoBody) return;  // pebbles move with their clump
     V f = P.force[i];
     A t = P.torque[i];
     if (damped) {
@@ -419,7 +456,9 @@ void Simulation<D>::initialIntegrate() {
     P.torque[i] = angZero<A>();
     a.vmax2 = std::max(a.vmax2, v.squaredNorm());
   });
-  contacts_.particle_travel += std::sqrt(acc.vmax2) * dt;
+  double vmax = std::sqrt(acc.vmax2);
+  if (clumped) integrateClumpsFirstHalf(vmax);
+  contacts_.particle_travel += vmax * dt;
   double wall_step = 0.0;
   for (auto& w : walls_) {
     w.point += dt * w.velocity;
@@ -443,7 +482,9 @@ void Simulation<D>::finalIntegrate() {
       driven += o.driven;
     }
   };
+  const bool clumped = hasClumps();
   const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
+    if (clumped && P.body[i] != kNoBody) return;
     const double im = P.inv_mass[i], ii = P.inv_inertia[i];
     if (im == 0.0) {
       // A fixed particle moves with its prescribed velocity and works on its neighbours
@@ -475,6 +516,12 @@ void Simulation<D>::finalIntegrate() {
   });
   kinetic_ = acc.ke_t + acc.ke_r;
   ledger_.local_damping += acc.damping;
+  if (clumped) {
+    double body_work = 0.0;
+    integrateClumpsSecondHalf(kinetic_, ledger_.local_damping, body_work);
+    ledger_.body_work += body_work;
+    ledger_.positive_input += std::max(body_work, 0.0);
+  }
   ledger_.boundary_work += acc.driven;
   ledger_.positive_input += std::max(acc.driven, 0.0);
 }
@@ -575,6 +622,7 @@ void Simulation<D>::rebuild() {
     }
   }
   grid_.build(P.pos, P.radius, C.skin, C.pairs);
+  if (hasClumps()) dropPairsWithinBodies(P.body, C.pairs);
 
   C.shear.assign(C.pairs.pairs(), V::Zero());
   for (std::size_t i = 0; i < n; ++i) {
@@ -633,6 +681,7 @@ void Simulation<D>::step() {
   if (needsRebuild()) rebuild();
 
   const bool overlap = computeForces(dt_);
+  if (hasClumps()) breakOverloadedClumps();
 
   t0 = std::chrono::steady_clock::now();
   finalIntegrate();
@@ -815,8 +864,35 @@ double Simulation<D>::criticalTimeStep() const {
     }
   }
   double dt = INFINITY;
+  // A clump's pebbles act in parallel on the body: their stiffnesses add up, the rotational
+  // ones with the arm from the centroid (bounded by distance plus radius).
+  const auto& K = clumps_;
+  for (std::uint32_t c = 0; c < K.size(); ++c) {
+    if (!K.alive[c]) continue;
+    double kt_body = 0.0, kr_body = 0.0;
+    const double density = K.mass[c] / K.volume[c];
+    for (std::uint32_t k = K.first[c]; k < K.first[c + 1]; ++k) {
+      const std::size_t i = P.indexOfSlot(K.member_slot[k]);
+      const double arm = (P.pos[i] - K.pos[c]).norm() + P.radius[i];
+      kt_body += kt[i];
+      kr_body += kr[i] + kt[i] * arm * arm;
+      // A pebble meeting something new moves at most its own mass (conservative bound).
+      const double m = density * P.volume(i);
+      dt = std::min(dt, model_->freeParticleStep(
+                            P.material[i], pairShape<D>(P.radius[i], P.radius[i], P.thickness),
+                            P.radius[i], m, particleInertia<D>(m, P.radius[i]), density));
+    }
+    double imin = 0.0;
+    if constexpr (D == 2) {
+      imin = K.principal[c];
+    } else {
+      imin = K.principal[c].minCoeff();
+    }
+    if (kt_body > 0.0) dt = std::min(dt, std::sqrt(K.mass[c] / kt_body));
+    if (kr_body > 0.0) dt = std::min(dt, std::sqrt(imin / kr_body));
+  }
   for (std::size_t i = 0; i < n; ++i) {
-    if (P.inv_mass[i] == 0.0) continue;
+    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
     const double m = 1.0 / P.inv_mass[i], inertia = 1.0 / P.inv_inertia[i];
     dt = std::min(dt, model_->freeParticleStep(P.material[i],
                                                pairShape<D>(P.radius[i], P.radius[i], P.thickness),
@@ -833,9 +909,15 @@ EnergyReport Simulation<D>::energy() const {
   EnergyReport e;
   e.ledger = ledger_;
   for (std::size_t i = 0; i < P.size(); ++i) {
-    if (P.inv_mass[i] == 0.0) continue;
+    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
     e.kinetic_translation += 0.5 * P.vel[i].squaredNorm() / P.inv_mass[i];
     e.kinetic_rotation += 0.5 * angDot(P.spin[i], P.spin[i]) / P.inv_inertia[i];
+  }
+  const auto& K = clumps_;
+  for (std::size_t c = 0; c < K.size(); ++c) {
+    if (!K.alive[c]) continue;
+    e.kinetic_translation += 0.5 * K.mass[c] * K.vel[c].squaredNorm();
+    e.kinetic_rotation += rotationalEnergy(K.spin[c], K.momentum[c]);
   }
   if (!model_) return e;
   forEachTouching([&](const Touching& t) {
@@ -888,8 +970,13 @@ double Simulation<D>::unbalancedForceRatio() const {
   double unbalanced = 0.0, contact = 0.0;
   std::size_t free = 0, count = 0;
   for (std::size_t i = 0; i < P.size(); ++i) {
-    if (P.inv_mass[i] == 0.0) continue;
+    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
     unbalanced += P.force[i].norm();
+    ++free;
+  }
+  for (std::size_t c = 0; c < clumps_.size(); ++c) {
+    if (!clumps_.alive[c]) continue;
+    unbalanced += clumps_.force[c].norm();
     ++free;
   }
   forEachTouching([&](const Touching& t) {
@@ -925,6 +1012,7 @@ std::uint64_t Simulation<D>::stateHash() const {
   h = hashVector(P.torque, h);
   h = hashVector(contacts_.shear, h);
   h = hashVector(contacts_.wall_shear, h);
+  h = hashVector(clumps_.momentum, h);
   for (const BondLoad<D>& l : bonds_.load) {
     h = fnv1a(&l.fn, sizeof l.fn, h);
     h = fnv1a(l.fs.data(), sizeof(double) * D, h);
@@ -991,6 +1079,9 @@ void Simulation<D>::visit(Archive& ar) {
   ar("ledger.viscous", ledger_.viscous), ar("ledger.local_damping", ledger_.local_damping);
   ar("ledger.positive_input", ledger_.positive_input), ar("ledger.started", ledger_.started);
   ar("ledger.bond_breakage", ledger_.bond_breakage);
+  ar("ledger.clump_release", ledger_.clump_release);
+  clumps_.visit(ar);
+  ar("clump_breaks", clump_breaks_);
   ar("bond_kinds", bond_kinds_), ar("bonds", bonds_), ar("bond_breaks", bond_breaks_);
   ar("broken_counts", broken_counts_);
   ar("time", time_), ar("dt", dt_), ar("step", step_), ar("kinetic", kinetic_);
@@ -1057,6 +1148,250 @@ Simulation<D> Simulation<D>::loadCheckpoint(const std::string& path) {
   sim.visit(r);
   if (!r.atEnd()) throw CheckpointError("checkpoint '" + path + "' has trailing data");
   return sim;
+}
+
+template <int D>
+std::uint32_t Simulation<D>::addClump(const std::vector<ParticleId>& pebbles, double strength,
+                                      int resolution) {
+  auto& P = particles_;
+  auto& K = clumps_;
+  if (pebbles.empty()) throw std::invalid_argument("a clump needs at least one pebble");
+  requireRange("clump", "strength", strength, 0.0, false, INFINITY, true, "Pa");
+  ClumpShape<D> shape;
+  std::vector<std::size_t> members;
+  double density = -1.0, msum = 0.0;
+  V momentum = V::Zero();
+  for (const ParticleId id : pebbles) {
+    const std::size_t i = P.index(id);
+    if (P.body[i] != kNoBody || std::find(members.begin(), members.end(), i) != members.end()) {
+      throw std::invalid_argument("particle slot " + std::to_string(id.slot) +
+                                  " is already a pebble of a clump");
+    }
+    if (P.inv_mass[i] == 0.0) throw std::invalid_argument("a fixed particle cannot join a clump");
+    const double m = 1.0 / P.inv_mass[i], rho = m / P.volume(i);
+    if (density < 0.0) density = rho;
+    if (std::abs(rho - density) > 1e-9 * density) {
+      throw std::invalid_argument("the pebbles of a clump must have one density");
+    }
+    shape.centers.push_back(P.pos[i]);
+    shape.radii.push_back(P.radius[i]);
+    momentum += m * P.vel[i];
+    msum += m;
+    members.push_back(i);
+  }
+  if (strength > 0.0) {
+    // Released pebbles interact again: overlapping ones would fly apart.
+    for (std::size_t a = 0; a < members.size(); ++a) {
+      for (std::size_t b = a + 1; b < members.size(); ++b) {
+        const double gap =
+            (shape.centers[a] - shape.centers[b]).norm() - shape.radii[a] - shape.radii[b];
+        if (gap < -0.01 * std::min(shape.radii[a], shape.radii[b])) {
+          throw std::invalid_argument(
+              "a breakable clump (strength > 0) needs pebbles that overlap by at most 1% of "
+              "the smaller radius: released, overlapping pebbles would repel each other");
+        }
+      }
+    }
+  }
+  const MassProperties<D> mp = massProperties<D>(shape, density, P.thickness, resolution);
+  const auto c = static_cast<std::uint32_t>(K.size());
+  Orientation<D> q;
+  A principal;
+  Eigen::Matrix<double, D, D> R = Eigen::Matrix<double, D, D>::Identity();
+  double diameter;
+  if constexpr (D == 2) {
+    q = 0.0;
+    principal = mp.inertia;
+    diameter = 2.0 * std::sqrt(mp.volume / P.thickness / std::numbers::pi);
+  } else {
+    // Principal frame: the eigenvectors of the inertia tensor, right-handed.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(mp.inertia);
+    R = es.eigenvectors();
+    if (R.determinant() < 0.0) R.col(2) *= -1.0;
+    principal = es.eigenvalues();
+    const Eigen::Quaterniond qq(R);
+    q = {qq.w(), qq.x(), qq.y(), qq.z()};
+    diameter = std::cbrt(6.0 * mp.volume / std::numbers::pi);
+  }
+  // The body takes the pebbles' momentum and their angular momentum about its centroid.
+  const V v = momentum / msum;
+  A L = angZero<A>();
+  for (const std::size_t i : members) {
+    const double m = 1.0 / P.inv_mass[i];
+    L += m * cross(V(P.pos[i] - mp.centroid), V(P.vel[i] - v)) + P.spin[i] / P.inv_inertia[i];
+  }
+  K.pos.push_back(mp.centroid);
+  K.vel.push_back(v);
+  K.spin.push_back(spinOf(L, principal, q));
+  K.momentum.push_back(L);
+  K.orientation.push_back(q);
+  K.principal.push_back(principal);
+  K.mass.push_back(mp.mass);
+  K.volume.push_back(mp.volume);
+  K.strength.push_back(strength);
+  K.diameter.push_back(diameter);
+  K.alive.push_back(1);
+  K.force.push_back(V::Zero());
+  K.damp_force.push_back(V::Zero());
+  K.torque.push_back(angZero<A>());
+  K.damp_torque.push_back(angZero<A>());
+  double imin;
+  if constexpr (D == 2) {
+    imin = principal;
+  } else {
+    imin = principal.minCoeff();
+  }
+  for (const std::size_t i : members) {
+    K.member_slot.push_back(P.slot_of[i]);
+    K.member_offset.push_back(R.transpose() * (P.pos[i] - mp.centroid));
+    P.body[i] = c;
+    // The body's mass and smallest moment: what a contact on the pebble moves (viscous
+    // damping's effective mass).
+    P.inv_mass[i] = 1.0 / mp.mass;
+    P.inv_inertia[i] = 1.0 / imin;
+  }
+  K.first.push_back(static_cast<std::uint32_t>(K.member_slot.size()));
+  placePebbles(c, false);
+  invalidateNeighbors();
+  return c;
+}
+
+template <int D>
+void Simulation<D>::placePebbles(std::uint32_t c, bool positions) {
+  auto& P = particles_;
+  const auto& K = clumps_;
+  const auto R = rotationOf(K.orientation[c]);
+  for (std::uint32_t k = K.first[c]; k < K.first[c + 1]; ++k) {
+    const std::size_t i = P.indexOfSlot(K.member_slot[k]);
+    const V r = R * K.member_offset[k];
+    if (positions) P.pos[i] = K.pos[c] + r;
+    P.vel[i] = K.vel[c] + cross(K.spin[c], r);
+    P.spin[i] = K.spin[c];
+  }
+}
+
+template <int D>
+void Simulation<D>::integrateClumpsFirstHalf(double& max_speed) {
+  auto& P = particles_;
+  auto& K = clumps_;
+  const double dt = dt_, h = 0.5 * dt_;
+  for (std::uint32_t c = 0; c < K.size(); ++c) {
+    if (!K.alive[c]) continue;
+    K.vel[c] += (h / K.mass[c]) * V(K.force[c] + K.damp_force[c]);
+    K.momentum[c] += h * (K.torque[c] + K.damp_torque[c]);
+    K.orientation[c] = advanceOrientation(K.orientation[c], K.momentum[c], K.principal[c], dt);
+    K.pos[c] += dt * K.vel[c];
+    K.spin[c] = spinOf(K.momentum[c], K.principal[c], K.orientation[c]);
+    placePebbles(c, true);
+    double reach = 0.0;
+    for (std::uint32_t k = K.first[c]; k < K.first[c + 1]; ++k) {
+      const std::size_t i = P.indexOfSlot(K.member_slot[k]);
+      reach = std::max(reach, K.member_offset[k].norm());
+      P.force[i].setZero();
+      P.torque[i] = angZero<A>();
+    }
+    max_speed = std::max(max_speed, K.vel[c].norm() + angNorm(K.spin[c]) * reach);
+  }
+}
+
+template <int D>
+void Simulation<D>::gatherClumpLoad(std::uint32_t c) {
+  const auto& P = particles_;
+  auto& K = clumps_;
+  V f = V::Zero();
+  for (int d = 0; d < D; ++d) f[d] = K.mass[c] * config_.gravity[d];
+  A t = angZero<A>();
+  for (std::uint32_t k = K.first[c]; k < K.first[c + 1]; ++k) {
+    const std::size_t i = P.indexOfSlot(K.member_slot[k]);
+    f += P.force[i];
+    t += P.torque[i] + cross(V(P.pos[i] - K.pos[c]), P.force[i]);
+  }
+  K.force[c] = f;
+  K.torque[c] = t;
+}
+
+template <int D>
+void Simulation<D>::integrateClumpsSecondHalf(double& kinetic, double& damping, double& body_work) {
+  auto& K = clumps_;
+  const double h = 0.5 * dt_, alpha = config_.local_damping;
+  V g = V::Zero();
+  for (int d = 0; d < D; ++d) g[d] = config_.gravity[d];
+  for (std::uint32_t c = 0; c < K.size(); ++c) {
+    if (!K.alive[c]) continue;
+    gatherClumpLoad(c);
+    const V f = K.force[c];
+    const A t = K.torque[c];
+    body_work += (K.mass[c] * g).dot(K.vel[c]) * dt_;  // over the drift x += v dt
+    V fd = V::Zero();
+    A td = angZero<A>();
+    if (alpha > 0.0) {
+      fd = localDamping(f, K.vel[c], alpha);
+      td = localDamping(t, K.spin[c], alpha);
+    }
+    K.damp_force[c] = fd;
+    K.damp_torque[c] = td;
+    K.vel[c] += (h / K.mass[c]) * V(f + fd);
+    K.momentum[c] += h * (t + td);
+    K.spin[c] = spinOf(K.momentum[c], K.principal[c], K.orientation[c]);
+    placePebbles(c, false);
+    kinetic +=
+        0.5 * K.mass[c] * K.vel[c].squaredNorm() + rotationalEnergy(K.spin[c], K.momentum[c]);
+    if (alpha > 0.0) damping -= (fd.dot(K.vel[c]) + angDot(td, K.spin[c])) * dt_;
+  }
+}
+
+template <int D>
+void Simulation<D>::breakOverloadedClumps() {
+  auto& K = clumps_;
+  bool breakable = false;
+  for (std::uint32_t c = 0; c < K.size() && !breakable; ++c) {
+    breakable = K.alive[c] && K.strength[c] > 0.0;
+  }
+  if (!breakable) return;
+  const auto& P = particles_;
+  std::vector<double> fmax(K.size(), 0.0);
+  forEachTouching([&](const Touching& t) {
+    const double fn = model_->normalForce(t.mi, t.mj, t.overlap, t.shape);
+    for (const std::size_t i : {t.i, t.j}) {
+      if (P.body[i] != kNoBody) fmax[P.body[i]] = std::max(fmax[P.body[i]], fn);
+    }
+  });
+  for (std::uint32_t c = 0; c < K.size(); ++c) {
+    if (!K.alive[c] || K.strength[c] <= 0.0) continue;
+    const double stress = fmax[c] / (K.diameter[c] * K.diameter[c]);
+    if (stress < K.strength[c]) continue;
+    clump_breaks_.push_back({step_, time_, K.pos[c], c, K.first[c + 1] - K.first[c], stress});
+    releaseClump(c);
+  }
+}
+
+template <int D>
+void Simulation<D>::releaseClump(std::uint32_t c) {
+  auto& P = particles_;
+  auto& K = clumps_;
+  if (c >= K.size() || !K.alive[c]) {
+    throw std::invalid_argument("clump " + std::to_string(c) + " does not exist or is broken");
+  }
+  placePebbles(c, false);
+  const double density = K.mass[c] / K.volume[c];
+  double after = 0.0;
+  for (std::uint32_t k = K.first[c]; k < K.first[c + 1]; ++k) {
+    const std::size_t i = P.indexOfSlot(K.member_slot[k]);
+    const double m = density * P.volume(i), inertia = particleInertia<D>(m, P.radius[i]);
+    P.body[i] = kNoBody;
+    P.inv_mass[i] = 1.0 / m;
+    P.inv_inertia[i] = 1.0 / inertia;
+    if (!damp_force_.empty()) {
+      damp_force_[i].setZero();
+      damp_torque_[i] = angZero<A>();
+    }
+    after += 0.5 * m * P.vel[i].squaredNorm() + 0.5 * inertia * angDot(P.spin[i], P.spin[i]);
+  }
+  const double before =
+      0.5 * K.mass[c] * K.vel[c].squaredNorm() + rotationalEnergy(K.spin[c], K.momentum[c]);
+  ledger_.clump_release += before - after;
+  K.alive[c] = 0;
+  contacts_.valid = false;  // the pebbles now meet each other: new candidate pairs
 }
 
 template class Simulation<2>;

@@ -19,6 +19,7 @@
 
 #include "lab/core/bond_forces.hpp"
 #include "lab/core/bonds.hpp"
+#include "lab/core/clumps.hpp"
 #include "lab/core/contact_model.hpp"
 #include "lab/core/contacts.hpp"
 #include "lab/core/material.hpp"
@@ -57,13 +58,16 @@ struct SimulationConfig {
 
 // Energy exchanged since the ledger started (J).
 struct EnergyLedger {
-  double initial = 0.0;         // kinetic + strain energy when the ledger started
-  double boundary_work = 0.0;   // work of walls and driven (fixed) particles on the others
-  double body_work = 0.0;       // work of gravity
-  double friction = 0.0;        // dissipated by Coulomb sliding
-  double viscous = 0.0;         // dissipated by contact dashpots
-  double local_damping = 0.0;   // dissipated by local (non-viscous) damping
-  double bond_breakage = 0.0;   // elastic energy bonds held when they broke
+  double initial = 0.0;        // kinetic + strain energy when the ledger started
+  double boundary_work = 0.0;  // work of walls and driven (fixed) particles on the others
+  double body_work = 0.0;      // work of gravity
+  double friction = 0.0;       // dissipated by Coulomb sliding
+  double viscous = 0.0;        // dissipated by contact dashpots
+  double local_damping = 0.0;  // dissipated by local (non-viscous) damping
+  double bond_breakage = 0.0;  // elastic energy bonds held when they broke
+  // Kinetic energy lost when clumps broke into pebbles (each pebble keeps its velocity in
+  // the body, but the pebbles' own masses differ from their share of the body's).
+  double clump_release = 0.0;
   double positive_input = 0.0;  // energy put in (for the runaway guard)
   bool started = false;
 };
@@ -77,7 +81,8 @@ struct EnergyReport {
   // Energy now held or dissipated, minus the energy that came in: zero for an exact scheme.
   double imbalance() const {
     return kinetic() + strain + ledger.friction + ledger.viscous + ledger.local_damping +
-           ledger.bond_breakage - (ledger.initial + ledger.boundary_work + ledger.body_work);
+           ledger.bond_breakage + ledger.clump_release -
+           (ledger.initial + ledger.boundary_work + ledger.body_work);
   }
 };
 
@@ -92,6 +97,23 @@ class SimulationUnstable : public std::runtime_error {
  private:
   Cause cause_;
   std::uint64_t step_;
+};
+
+// A clump that broke into its pebbles.
+template <int D>
+struct ClumpBreak {
+  std::uint64_t step = 0;
+  double time = 0.0;
+  Vec<D> position = Vec<D>::Zero();  // centroid
+  std::uint32_t clump = 0;
+  std::uint32_t pebbles = 0;
+  double stress = 0.0;  // Pa, characteristic stress that broke it
+
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("step", step), ar("time", time), ar("position", position), ar("clump", clump);
+    ar("pebbles", pebbles), ar("stress", stress);
+  }
 };
 
 struct StageTiming {
@@ -147,13 +169,29 @@ class Simulation {
   // Installs a bond of `kind` with zero load on every particle pair that touches or whose
   // gap is below gap_ratio times the smaller radius (the sample is "formed under stress":
   // the bonds take only what comes after). Strengths are drawn per bond from the scene's
-  // random stream. Pairs already bonded are left as they are.
+  // random stream. Pairs already bonded are left as they are. An intragranular kind joins
+  // only particles of one cluster (grain), any other kind only particles of different
+  // clusters (or of none); pebbles of one clump are never bonded.
   CementReport cement(std::uint8_t kind, double gap_ratio);
   const BondStore<D>& bonds() const { return bonds_; }
   // Bonds broken so far of a kind and mode.
   std::uint64_t brokenBonds(std::uint8_t kind, BondBreakMode mode) const;
   // The breaks logged since the last call, oldest first (hands them to the notebook).
   std::vector<BondBreak<D>> takeBondBreaks() { return std::exchange(bond_breaks_, {}); }
+
+  // --- clumps (rigid bodies of pebbles) ---
+  // Makes the given particles, all of one density, a rigid clump with their momentum and
+  // their angular momentum about its centroid; contacts between them are never formed
+  // again. `strength` (Pa, 0: never)
+  // breaks it back into its pebbles when the largest normal contact force F on a pebble
+  // gives a characteristic stress F / d^2 (d: the clump's equivalent diameter; McDowell &
+  // Bolton 1998, "On the micromechanics of crushable aggregates") at or above it.
+  std::uint32_t addClump(const std::vector<ParticleId>& pebbles, double strength = 0.0,
+                         int resolution = 128);
+  const ClumpStore<D>& clumps() const { return clumps_; }
+  // Breaks a clump into its pebbles, which keep the velocity they had in the body.
+  void releaseClump(std::uint32_t clump);
+  std::vector<ClumpBreak<D>> takeClumpBreaks() { return std::exchange(clump_breaks_, {}); }
 
   // --- running ---
   // Validates the settings, builds the contact model and the neighbour list, evaluates the
@@ -191,7 +229,7 @@ class Simulation {
   // --- checkpoints ---
   void saveCheckpoint(const std::string& path) const;
   static Simulation loadCheckpoint(const std::string& path);
-  static constexpr std::uint32_t kCheckpointVersion = 1;
+  static constexpr std::uint32_t kCheckpointVersion = 2;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };
@@ -201,6 +239,12 @@ class Simulation {
   // step); returns whether an overlap exceeded the guard's limit.
   bool computeForces(double history_dt);
   void computeBondForces(double dt);
+  void integrateClumpsFirstHalf(double& max_speed);
+  void integrateClumpsSecondHalf(double& kinetic, double& damping, double& body_work);
+  void placePebbles(std::uint32_t c, bool positions);
+  void gatherClumpLoad(std::uint32_t c);
+  void breakOverloadedClumps();
+  bool hasClumps() const { return !clumps_.pos.empty(); }
   void initialIntegrate();
   void finalIntegrate();
   bool needsRebuild();
@@ -239,6 +283,8 @@ class Simulation {
   BondForces<D> bond_forces_;
   std::vector<BondBreak<D>> bond_breaks_;
   std::vector<std::uint64_t> broken_counts_;  // 2 per kind: tensile, shear
+  ClumpStore<D> clumps_;
+  std::vector<ClumpBreak<D>> clump_breaks_;
 
   double time_ = 0.0;
   double dt_ = 0.0;
