@@ -60,6 +60,8 @@ void renderFigure(const Figure& f, const std::string& dir) {
   vtkNew<vtkChartMatrix> matrix;
   matrix->SetSize(vtkVector2i(1, panels));
   matrix->SetGutter(vtkVector2f(30.0f, 60.0f));
+  // Room on the left for five-digit tick labels and the axis title beside them.
+  matrix->SetBorders(90, 50, 20, 40);
   view->GetScene()->AddItem(matrix);
   for (int p = 0; p < panels; ++p) {
     const Panel& panel = f.panels[p];
