@@ -1,5 +1,6 @@
 #include "rigs/registry.hpp"
 
+#include "rigs/biaxial/biaxial.hpp"
 #include "rigs/common/specimen.hpp"
 #include "rigs/hydrostatic/hydrostatic.hpp"
 #include "rigs/oedometer/oedometer.hpp"
@@ -11,6 +12,10 @@ const std::vector<RigEntry>& rigTable() {
       {"oedometer",
        "uniaxial strain: lateral walls fixed, axial strain rate or stress ramp, cycles, coring",
        oedometer::declare, oedometer::validate, oedometer::run},
+      {"biaxial",
+       "biaxial frame (2D) / triaxial cell (3D): confinement held by servo walls, axial strain "
+       "rate through the peak; zero confinement is the UCS test",
+       biaxial::declare, biaxial::validate, biaxial::run},
       {"hydrostatic", "all walls servo-controlled to one stress, ramped up and optionally down",
        hydrostatic::declare, hydrostatic::validate, hydrostatic::run},
   };

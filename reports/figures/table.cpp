@@ -6,6 +6,7 @@ const std::vector<FigureEntry>& figureTable() {
   static const std::vector<FigureEntry> table = {
       {"oedometer", oedometerFigures},
       {"hydrostatic", hydrostaticFigures},
+      {"biaxial", biaxialFigures},
   };
   return table;
 }

@@ -5,6 +5,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "lab/core/grains.hpp"
 #include "lab/core/packing.hpp"
 
 namespace rocklab::rigs {
@@ -19,7 +20,36 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
   range(s.integer("protocol.seed", 1, "seed of the packing and the bond strengths"), 0, false, 9e15,
         false);
 
-  range(s.integer("sample.count", std::nullopt, "number of particles"), 2, false, 5e7, false);
+  s.choice("sample.kind", {"spheres", "grains"}, "spheres",
+           "spheres: one disk or sphere per grain; grains: breakable superparticles, pebbles "
+           "joined by intragranular bonds (grains.*, grain_bonds.*; Li & Holt section 2.2)");
+  range(s.integer("sample.count", std::nullopt, "number of particles (grains for kind = grains)"),
+        2, false, 5e7, false);
+  range(s.integer("grains.pebbles_across", 4, "pebbles along a grain's long axis"), 2, false, 20,
+        false);
+  range(s.real("grains.max_aspect_ratio", "-", 1, 1.5,
+               "longest over shortest caliper of every grain, exclusive"),
+        1, true, 10, false);
+  range(s.real("grains.roughness", "-", 1, 0.15, "relative amplitude of the outline's bumps"), 0,
+        false, 0.5, false);
+  range(s.real("grain_bonds.modulus_GPa", "GPa", 1e9, 8.0,
+               "intragranular bond modulus, kn = E / L as for cement"),
+        0, true, 1e4, false);
+  range(s.real("grain_bonds.stiffness_ratio", "-", 1, 1.0, "kn / ks of intragranular bonds"), 0,
+        true, 100, false);
+  range(s.real("grain_bonds.radius_multiplier", "-", 1, 1.0,
+               "intragranular bond radius over the pebble radius"),
+        0, true, 10, false);
+  range(s.real("grain_bonds.tensile_strength_mean_MPa", "MPa", 1e6, 40.0,
+               "mean tensile strength of intragranular bonds"),
+        0, true, 1e5, false);
+  range(s.real("grain_bonds.tensile_strength_std_MPa", "MPa", 1e6, 0.0, "its std"), 0, false, 1e5,
+        false);
+  range(s.real("grain_bonds.shear_strength_mean_MPa", "MPa", 1e6, 40.0,
+               "mean shear strength of intragranular bonds"),
+        0, true, 1e5, false);
+  range(s.real("grain_bonds.shear_strength_std_MPa", "MPa", 1e6, 0.0, "its std"), 0, false, 1e5,
+        false);
   s.choice("sample.size_distribution", {"uniform", "normal", "phi"}, "phi",
            "diameters uniform in [d_min, d_max], normal(d_mean, d_std), or Gaussian in "
            "phi = -log2(d / 1 mm); normal and phi are truncated to [d_min, d_max]");
@@ -237,39 +267,102 @@ Specimen<D> Specimen<D>::branch() const {
   b.density = density;
   b.cement_kind = cement_kind;
   b.cement = cement;
+  b.grain_kind = grain_kind;
+  b.grain_bonds = grain_bonds;
+  b.grain_aspect_ratios = grain_aspect_ratios;
+  b.fragments_reference = fragments_reference;
   b.record_every = record_every;
-  b.broken_offset[0] = broken_offset[0];
-  b.broken_offset[1] = broken_offset[1];
+  b.snapshot_every = snapshot_every;
+  std::copy(std::begin(broken_offset), std::end(broken_offset), std::begin(b.broken_offset));
   return b;
 }
 
 template <int D>
 std::uint64_t Specimen<D>::broken(BondBreakMode mode) const {
-  if (sim->bondKinds().empty()) return 0;
-  return sim->brokenBonds(cement_kind, mode) - broken_offset[mode == BondBreakMode::Shear];
+  if (!cement_kind) return 0;
+  return sim->brokenBonds(*cement_kind, mode) - broken_offset[mode == BondBreakMode::Shear];
+}
+
+template <int D>
+std::uint64_t Specimen<D>::brokenInGrains(BondBreakMode mode) const {
+  if (!grain_kind) return 0;
+  return sim->brokenBonds(*grain_kind, mode) - broken_offset[2 + (mode == BondBreakMode::Shear)];
+}
+
+template <int D>
+std::size_t Specimen<D>::crushedGrains() const {
+  if (!grain_kind) return 0;
+  return rocklab::crushedGrains(
+      fragments_reference, grainFragments<D>(sim->particles(), sim->bonds(), sim->bondKinds()));
 }
 
 template <int D>
 void Specimen<D>::resetBrokenCount() {
-  if (sim->bondKinds().empty()) return;
-  broken_offset[0] = sim->brokenBonds(cement_kind, BondBreakMode::Tensile);
-  broken_offset[1] = sim->brokenBonds(cement_kind, BondBreakMode::Shear);
+  for (int m = 0; m < 2; ++m) {
+    const auto mode = m == 0 ? BondBreakMode::Tensile : BondBreakMode::Shear;
+    if (cement_kind) broken_offset[m] = sim->brokenBonds(*cement_kind, mode);
+    if (grain_kind) broken_offset[2 + m] = sim->brokenBonds(*grain_kind, mode);
+  }
+  if (grain_kind) {
+    fragments_reference = grainFragments<D>(sim->particles(), sim->bonds(), sim->bondKinds());
+  }
 }
+
+namespace {
+
+// The packing of the protocol: spheres by radius expansion, or grains grown as rigid
+// bodies (then `grain` holds each pebble's grain).
+template <int D>
+Packing<D> makePacking(const Settings& s, RunControl& control, std::vector<std::uint32_t>& grain,
+                       std::vector<double>& aspect_ratios) {
+  const auto count = static_cast<std::size_t>(s.integer("sample.count"));
+  std::array<double, 3> aspect{1.0, 1.0, 1.0};
+  aspect[D - 1] = s.real("sample.aspect_axial");
+  const auto seed = static_cast<std::uint64_t>(s.integer("protocol.seed"));
+  const int threads = static_cast<int>(s.integer("numerics.threads"));
+  auto progress = [&](double f) { control.tick("packing", 0, f, "growth to the porosity"); };
+  if (s.text("sample.kind") == "grains") {
+    GrainPackingSpec g;
+    g.grains = count;
+    g.sizes = sizes(s);
+    g.shape.pebbles_across = static_cast<int>(s.integer("grains.pebbles_across"));
+    g.shape.max_aspect_ratio = s.real("grains.max_aspect_ratio");
+    g.shape.roughness = s.real("grains.roughness");
+    g.porosity = s.real("sample.porosity_initial");
+    g.aspect = aspect;
+    g.thickness = s.real("sample.thickness_m");
+    g.seed = seed;
+    g.threads = threads;
+    g.progress = progress;
+    GrainPacking<D> out = generateGrainPacking<D>(g);
+    grain = std::move(out.grain);
+    aspect_ratios = std::move(out.grain_aspect_ratio);
+    return std::move(out.pebbles);
+  }
+  PackingSpec spec;
+  spec.count = count;
+  spec.sizes = sizes(s);
+  spec.porosity = s.real("sample.porosity_initial");
+  spec.aspect = aspect;
+  spec.thickness = s.real("sample.thickness_m");
+  spec.seed = seed;
+  spec.threads = threads;
+  spec.progress = progress;
+  return generatePacking<D>(spec);
+}
+
+}  // namespace
 
 template <int D>
 Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
-  control.tick("packing", 0, -1.0, "random placement and radius expansion");
+  control.tick("packing", 0, -1.0, "random placement and growth");
+  std::vector<std::uint32_t> grain;
+  std::vector<double> aspect_ratios;
+  const Packing<D> p = makePacking<D>(s, control, grain, aspect_ratios);
   PackingSpec spec;
-  spec.count = static_cast<std::size_t>(s.integer("sample.count"));
-  spec.sizes = sizes(s);
-  spec.porosity = s.real("sample.porosity_initial");
-  spec.aspect = {1.0, 1.0, 1.0};
-  spec.aspect[D - 1] = s.real("sample.aspect_axial");
   spec.thickness = s.real("sample.thickness_m");
   spec.seed = static_cast<std::uint64_t>(s.integer("protocol.seed"));
   spec.threads = static_cast<int>(s.integer("numerics.threads"));
-  spec.progress = [&](double f) { control.tick("packing", 0, f, "radius expansion"); };
-  const Packing<D> p = generatePacking<D>(spec);
 
   Specimen<D> sp;
   sp.mean_radius =
@@ -293,7 +386,25 @@ Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
     ps.position = p.centers[i];
     ps.radius = p.radii[i];
     ps.density = sp.density;
+    if (!grain.empty()) ps.cluster = grain[i];
     sp.sim->particles().add(ps);
+  }
+  if (!grain.empty()) {
+    // The grains are whole from the start: their intragranular bonds go in now, unloaded.
+    BondKind k;
+    k.name = "grain";
+    k.intragranular = true;
+    k.modulus = s.si("grain_bonds.modulus_GPa");
+    k.stiffness_ratio = s.real("grain_bonds.stiffness_ratio");
+    k.radius_multiplier = s.real("grain_bonds.radius_multiplier");
+    k.tensile_mean = s.si("grain_bonds.tensile_strength_mean_MPa");
+    k.tensile_std = s.si("grain_bonds.tensile_strength_std_MPa");
+    k.shear_mean = s.si("grain_bonds.shear_strength_mean_MPa");
+    k.shear_std = s.si("grain_bonds.shear_strength_std_MPa");
+    k.negative = NegativeStrength::Resample;  // a grain is never born cracked
+    sp.grain_kind = sp.sim->addBondKind(k);
+    sp.grain_bonds = sp.sim->cement(*sp.grain_kind, 1e-3);
+    sp.grain_aspect_ratios = std::move(aspect_ratios);
   }
   sp.frame = std::make_unique<LoadingFrame<D>>(*sp.sim, p.lo, p.hi, 1);
   sp.sim->prepare();
@@ -338,7 +449,7 @@ void formAndCement(Specimen<D>& sp, const Settings& s, Recorder& rec, RunControl
     k.negative = s.text("bonds.negative_strength") == "resample" ? NegativeStrength::Resample
                                                                  : NegativeStrength::Skip;
     sp.cement_kind = sim.addBondKind(k);
-    sp.cement = sim.cement(sp.cement_kind, s.real("bonds.gap_ratio"));
+    sp.cement = sim.cement(*sp.cement_kind, s.real("bonds.gap_ratio"));
     rec.result("bonds_installed", static_cast<double>(sp.cement.installed), "");
     rec.result("bonds_skipped_nonpositive", static_cast<double>(sp.cement.skipped_nonpositive), "");
     rec.result("bonds_redrawn", static_cast<double>(sp.cement.redrawn), "");
@@ -414,6 +525,26 @@ void recordTimings(Recorder& rec, const std::vector<const Simulation<D>*>& sims)
 }
 
 template <int D>
+void warnIfNotQuasiStatic(const Simulation<D>& sim, const Settings& s, Recorder& rec,
+                          const std::string& stage, double mean_unbalanced, double inertial_max) {
+  const double ub_limit = s.real("numerics.quasi_static_unbalanced");
+  const double i_limit = s.real("numerics.quasi_static_inertial");
+  if (mean_unbalanced > ub_limit) {
+    rec.message(sim.steps(), sim.time(), "warning",
+                stage + " was not quasi-static: mean unbalanced force ratio " +
+                    fmt(mean_unbalanced) + " > " + fmt(ub_limit) +
+                    " (numerics.quasi_static_unbalanced); lower the loading rate");
+  }
+  if (inertial_max > i_limit) {
+    rec.message(sim.steps(), sim.time(), "warning",
+                stage + " was not quasi-static: inertial number up to " + fmt(inertial_max) +
+                    " > " + fmt(i_limit) +
+                    " (numerics.quasi_static_inertial); lower "
+                    "loading.axial_strain_rate_per_s");
+  }
+}
+
+template <int D>
 double inertialNumber(const Specimen<D>& sp, double strain_rate) {
   const double p = std::abs(sp.frame->meanStress());
   if (!(p > 0.0)) return INFINITY;
@@ -434,6 +565,7 @@ void recordBreaks(Specimen<D>& sp, Recorder& rec, const std::string& stage) {
     e.x = b.position[0];
     e.y = b.position[1];
     if constexpr (D == 3) e.z = b.position[2];
+    if (sp.keep_break_positions) sp.break_positions.push_back({e.x, e.y, e.z});
     e.particle_a = b.a.slot;
     e.particle_b = b.b.slot;
     e.value = b.stress;
@@ -469,6 +601,12 @@ void recordState(Specimen<D>& sp, Recorder& rec, const std::string& prefix,
   put("broken_bonds_tensile", tensile);
   put("broken_bonds_shear", shear);
   put("broken_bonds_total", tensile + shear);
+  if (sp.grain_kind) {
+    put("broken_grain_bonds_tensile",
+        static_cast<double>(sp.brokenInGrains(BondBreakMode::Tensile)));
+    put("broken_grain_bonds_shear", static_cast<double>(sp.brokenInGrains(BondBreakMode::Shear)));
+    put("crushed_grains", static_cast<double>(sp.crushedGrains()));
+  }
   put("unbalanced_force_ratio", sim.unbalancedForceRatio());
   if (strain_rate != 0.0) put("inertial_number", inertialNumber(sp, strain_rate));
   recordBreaks(sp, rec, stage);
@@ -495,6 +633,10 @@ template void snapshot<3>(Specimen<3>&, const Settings&, Recorder&, const std::s
                           const std::string&);
 template void recordBreaks<3>(Specimen<3>&, Recorder&, const std::string&);
 template double inertialNumber<2>(const Specimen<2>&, double);
+template void warnIfNotQuasiStatic<2>(const Simulation<2>&, const Settings&, Recorder&,
+                                      const std::string&, double, double);
+template void warnIfNotQuasiStatic<3>(const Simulation<3>&, const Settings&, Recorder&,
+                                      const std::string&, double, double);
 template void recordTimings<2>(Recorder&, const std::vector<const Simulation<2>*>&);
 template void recordTimings<3>(Recorder&, const std::vector<const Simulation<3>*>&);
 template double inertialNumber<3>(const Specimen<3>&, double);

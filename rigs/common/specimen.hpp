@@ -5,6 +5,7 @@
 // formation, numerics, output) are declared here once.
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "lab/protocol/params.hpp"
@@ -24,19 +25,31 @@ template <int D>
 struct Specimen {
   std::unique_ptr<Simulation<D>> sim;
   std::unique_ptr<LoadingFrame<D>> frame;
-  double mean_radius = 0.0;  // m
-  double density = 0.0;      // kg/m^3
-  std::uint8_t cement_kind = 0;
+  double mean_radius = 0.0;                 // m
+  double density = 0.0;                     // kg/m^3
+  std::optional<std::uint8_t> cement_kind;  // intergranular cement, once cemented
   CementReport cement;
+  // Breakable grains (sample.kind = grains): their bond kind, what was installed, and each
+  // grain's measured aspect ratio.
+  std::optional<std::uint8_t> grain_kind;
+  CementReport grain_bonds;
+  std::vector<double> grain_aspect_ratios;
   std::uint64_t record_every = 500;
   std::uint64_t snapshot_every = 0;  // 0: only at the ends of stages
-  // Bonds broken before the measured stage (formation, coring) are not counted in it.
-  std::uint64_t broken_offset[2] = {0, 0};
+  // Bonds broken before the measured stage (formation, coring) are not counted in it:
+  // cement tensile, shear, then grain tensile, shear; likewise the grains' fragments.
+  std::uint64_t broken_offset[4] = {0, 0, 0, 0};
+  std::vector<std::uint32_t> fragments_reference;
+  // Positions of the breaks handed to the notebook while this is on (localisation).
+  bool keep_break_positions = false;
+  std::vector<std::array<double, 3>> break_positions;
 
   static constexpr int kAxial = D - 1;  // z in 3D, y in 2D
   // A deep copy for a branch of the experiment (e.g. virgin and cored).
   Specimen branch() const;
-  std::uint64_t broken(BondBreakMode mode) const;
+  std::uint64_t broken(BondBreakMode mode) const;          // cement
+  std::uint64_t brokenInGrains(BondBreakMode mode) const;  // intragranular
+  std::size_t crushedGrains() const;  // grains in more fragments than at the reference
   void resetBrokenCount();
 };
 
@@ -73,6 +86,13 @@ void snapshot(Specimen<D>& sp, const Settings& s, Recorder& rec, const std::stri
 // The stage timings of the simulations an experiment ran (branches summed), to the recorder.
 template <int D>
 void recordTimings(Recorder& rec, const std::vector<const Simulation<D>*>& sims);
+
+// Quasi-static control is measured, not assumed: warns (a notebook message) when a
+// loading stage's mean unbalanced force ratio or largest inertial number (0: not measured)
+// passed the protocol's limits.
+template <int D>
+void warnIfNotQuasiStatic(const Simulation<D>& sim, const Settings& s, Recorder& rec,
+                          const std::string& stage, double mean_unbalanced, double inertial_max);
 
 // The inertial number I = edot d sqrt(rho / p) of the present loading: below about 1e-3 a
 // granular test is quasi-static (GDR MiDi 2004; da Cruz et al. 2005).

@@ -241,22 +241,7 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
   put("mean_unbalanced_force_ratio", mean_unbalanced, "");
   if (strain_control) put("max_inertial_number", inertial_max, "");
 
-  // Quasi-static control is measured, not assumed.
-  const double ub_limit = s.real("numerics.quasi_static_unbalanced");
-  const double i_limit = s.real("numerics.quasi_static_inertial");
-  if (mean_unbalanced > ub_limit) {
-    rec.message(sim.steps(), sim.time(), "warning",
-                stage + " was not quasi-static: mean unbalanced force ratio " +
-                    fmt(mean_unbalanced) + " > " + fmt(ub_limit) +
-                    " (numerics.quasi_static_unbalanced); lower the loading rate");
-  }
-  if (strain_control && inertial_max > i_limit) {
-    rec.message(sim.steps(), sim.time(), "warning",
-                stage + " was not quasi-static: inertial number up to " + fmt(inertial_max) +
-                    " > " + fmt(i_limit) +
-                    " (numerics.quasi_static_inertial); lower "
-                    "loading.axial_strain_rate_per_s");
-  }
+  warnIfNotQuasiStatic(sim, s, rec, stage, mean_unbalanced, strain_control ? inertial_max : 0.0);
   return e0;
 }
 

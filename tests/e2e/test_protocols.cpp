@@ -159,6 +159,64 @@ lateral_stress_MPa = 5
 
 // A loading fast for the grains' inertia is flagged in the notebook, not passed off as a
 // quasi-static test.
+// Runs a quick protocol into its own notebook and returns it.
+nb::Notebook runQuick(const Lab& lab, const std::string& protocol) {
+  std::string out;
+  EXPECT_EQ(rocklab::testing::runRocklab("run " + sourceDir() + "/protocols/" + protocol +
+                                             ".toml --quiet --threads 1 --lab " + lab.path,
+                                         &out),
+            0)
+      << out;
+  return nb::Notebook(lab.path);
+}
+
+// Li & Holt section 2.3: the superparticle sample's UCS is 9.9 MPa (calibrated: measured
+// 9.77 MPa on the quick sample; +-25% allows for another seed of 250 grains).
+TEST(QuickProtocols, SuperparticleSampleHasThePapersUcs) {
+  Lab lab("ucs");
+  nb::Notebook n = runQuick(lab, "biaxial-ucs-quick");
+  EXPECT_EQ(scalar(n, "SELECT status FROM runs"), "completed");
+  EXPECT_NEAR(result(n, "ucs_MPa"), 9.9, 0.25 * 9.9);
+  // Grains as generated: irregular, every one below the aspect limit (measured mean 1.26).
+  EXPECT_LT(result(n, "grain_aspect_ratio_max"), 1.5);
+  EXPECT_GT(result(n, "grain_aspect_ratio_mean"), 1.1);
+  // Zero confinement: the lateral walls keep clear (judged against 1 MPa; measured 0.65%).
+  EXPECT_LT(result(n, "confining_stress_error_max"), 0.01);
+  // Unconfined, the cement fails, the grains stay whole (measured: 46 cement breaks, none
+  // inside grains).
+  EXPECT_GT(result(n, "broken_bonds_tensile"), result(n, "broken_bonds_shear"));
+  EXPECT_LE(result(n, "crushed_grains"), 2.0);
+}
+
+// Low against high confinement (Figures 4 and 5): at 4 MPa mainly tensile intergranular
+// breaks and next to no crushing; at 18 MPa more shear breaks and much more crushing, and
+// the sample compacts (measured at 4 MPa: 71 tensile / 47 shear cement breaks, 1 crushed
+// grain; at 18 MPa: 177 / 287, 19 crushed grains, volumetric strain 1.2% at the peak).
+TEST(QuickProtocols, HighConfinementBreaksInShearAndCrushesGrains) {
+  Lab low_lab("shear-band"), high_lab("compaction-band");
+  nb::Notebook low = runQuick(low_lab, "biaxial-shear-band-quick");
+  nb::Notebook high = runQuick(high_lab, "biaxial-compaction-band-quick");
+  for (nb::Notebook* n : {&low, &high}) {
+    EXPECT_EQ(scalar(*n, "SELECT status FROM runs"), "completed");
+    // The servo holds sigma_3 within 1% once loading starts (the bound).
+    EXPECT_LT(result(*n, "confining_stress_error_max"), 0.01);
+  }
+  EXPECT_GT(result(low, "broken_bonds_tensile"), result(low, "broken_bonds_shear"));
+  auto shear_share = [&](nb::Notebook& n) {
+    return result(n, "broken_bonds_shear") /
+           (result(n, "broken_bonds_shear") + result(n, "broken_bonds_tensile"));
+  };
+  EXPECT_GT(shear_share(high), shear_share(low) + 0.1);
+  EXPECT_GT(result(high, "crushed_grains"), 3 * std::max(1.0, result(low, "crushed_grains")));
+  EXPECT_GT(result(high, "peak_deviatoric_stress_MPa"), result(low, "peak_deviatoric_stress_MPa"));
+  EXPECT_GT(result(high, "volumetric_strain_at_peak"), 0.005);  // compaction, positive
+  // Every break is an event with its kind: intragranular breaks are the crushing.
+  EXPECT_EQ(std::stod(scalar(high,
+                             "SELECT count(*) FROM events WHERE granular = 'intra' AND "
+                             "stage = 'loading'")),
+            result(high, "broken_grain_bonds_tensile") + result(high, "broken_grain_bonds_shear"));
+}
+
 TEST(Protocols, FastLoadingIsFlaggedAsNotQuasiStatic) {
   Lab lab("fast");
   const std::string file = writeProtocol(

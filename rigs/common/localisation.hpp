@@ -1,0 +1,36 @@
+#pragma once
+// Localisation: the failure band in a cloud of damage (broken-bond positions). Every
+// plane (2D: line) orientation is tried; the points are projected on its normal and
+// counted in a sliding window of the trial band's width; the band is the orientation and
+// offset holding the most points (a Hough transform with a box kernel). Its angle to the
+// axial (sigma_1) direction, its thickness and its contrast over a uniform cloud follow.
+// A band within 20 degrees of normal to sigma_1 is a compaction band (Li & Holt section
+// 2.3: "a failure zone normal to maximum principal stress"; Olsson 1999), an inclined one
+// a shear band.
+
+#include <array>
+#include <vector>
+
+namespace rocklab::rigs {
+
+struct Band {
+  double angle_to_axial_deg = 0.0;  // between the band (its plane) and the sigma_1 axis, 0..90
+  // m, sqrt(12) standard deviations of the points within one trial width of the band's
+  // centre: the width of a uniform band with their spread
+  double thickness = 0.0;
+  double offset = 0.0;             // m, position of the band's centre along its normal
+  std::array<double, 3> normal{};  // unit normal of the band
+  // points in the band over the median of windows as wide across the cloud's middle half
+  double contrast = 0.0;
+  std::size_t points = 0;  // points in the band
+  bool is_compaction() const { return angle_to_axial_deg >= 70.0; }
+};
+
+// `points` in 2 or 3 dimensions (z ignored in 2D), `axial` the sigma_1 axis (1: y in 2D,
+// 2: z in 3D), `width` the trial band width (m). Needs at least 10 points; the
+// orientations are tried every 0.25 degrees (2D) or on 20,000 directions (3D, about 0.8
+// degrees apart).
+Band findBand(const std::vector<std::array<double, 3>>& points, int dimension, int axial,
+              double width);
+
+}  // namespace rocklab::rigs
