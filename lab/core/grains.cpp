@@ -245,62 +245,22 @@ GrainPacking<D> generateGrainPacking(const GrainPackingSpec& spec, PackingReport
   for (double& r : r0) r *= s0;
   const std::vector<Vec<D>> x0 = placeRandomly<D>(r0, out.pebbles.lo, out.pebbles.hi, rng);
 
-  // Growth as in generatePacking: a soft frictionless linear-spring scene, here of rigid
-  // clumps, so that the grains keep their shapes.
-  Material m;
-  m.name = "expansion";
-  m.kn = 1e8 * (D == 3 ? r_mean : spec.thickness);
-  m.ks = 0.5 * m.kn;
-  m.friction = 0.0;
-  m.damping_ratio = 0.2;
-  MaterialTable mats;
-  mats.add(m);
-  SimulationConfig cfg;
-  cfg.contact_law = "linear";
-  cfg.local_damping = 0.7;
-  cfg.threads = spec.threads;
-  cfg.track_energy = false;
-  cfg.guard.overlap_limit = 0.95;
-  cfg.guard.energy_runaway = false;
-  Simulation<D> sim(mats, cfg);
-  sim.particles().thickness = spec.thickness;
+  // Growth as in generatePacking, here of rigid clumps, so that the grains keep their shapes.
+  Simulation<D> sim =
+      expansionScene<D>(r_mean, spec.thickness, 0.0, spec.threads, out.pebbles.lo, out.pebbles.hi);
   for (std::size_t g = 0; g < shapes.size(); ++g) {
     std::vector<ParticleId> ids;
     for (std::size_t k = 0; k < shapes[g].centers.size(); ++k) {
       ParticleSpec<D> p;
       p.position = x0[g] + s0 * shapes[g].centers[k];
       p.radius = s0 * shapes[g].radii[k];
-      p.density = m.density;
+      p.density = kExpansionDensity;
       p.cluster = static_cast<std::uint32_t>(g);
       ids.push_back(sim.particles().add(p));
     }
     sim.addClump(ids, 0.0, 16);  // inertia only steers the packing: coarse is enough
   }
-  for (int d = 0; d < D; ++d) {
-    Wall<D> lo_wall, hi_wall;
-    lo_wall.name = std::string(1, "xyz"[d]) + "min";
-    hi_wall.name = std::string(1, "xyz"[d]) + "max";
-    lo_wall.normal = Vec<D>::Unit(d);
-    lo_wall.point = out.pebbles.lo;
-    hi_wall.normal = -Vec<D>::Unit(d);
-    hi_wall.point = out.pebbles.hi;
-    sim.addWall(lo_wall);
-    sim.addWall(hi_wall);
-  }
-  const double growth = std::log(1.0 / s0);
-  const auto grow_steps = static_cast<std::uint64_t>(std::max(500.0, std::ceil(growth / 2e-4)));
-  const double factor = std::exp(growth / static_cast<double>(grow_steps));
-  for (std::uint64_t k = 0; k < grow_steps; ++k) {
-    sim.scaleRadii(factor);
-    sim.step();
-    if (spec.progress && k % 100 == 0) spec.progress(0.5 * static_cast<double>(k) / grow_steps);
-  }
-  const std::uint64_t relax_max = 40000;
-  for (std::uint64_t k = 0; k < relax_max; k += 100) {
-    sim.run(100);
-    if (spec.progress) spec.progress(0.5 + 0.5 * static_cast<double>(k) / relax_max);
-    if (sim.maxOverlapRatio() < 1e-3 || sim.unbalancedForceRatio() < 1e-3) break;
-  }
+  growAndRelax<D>(sim, s0, spec.progress, {});
 
   // Pebbles in slot order (grain by grain), at their exact sizes.
   const auto& P = sim.particles();

@@ -163,6 +163,70 @@ std::vector<Vec<D>> placeRandomly(const std::vector<double>& r, const Vec<D>& lo
 }
 
 template <int D>
+Simulation<D> expansionScene(double r_mean, double thickness, double friction, int threads,
+                             const Vec<D>& lo, const Vec<D>& hi) {
+  // A soft linear-spring scene: the result is geometric, and a soft spring gives a long
+  // time step. Overlap per growth step relative to the radius is set by the growth rate,
+  // not by the stiffness.
+  Material m;
+  m.name = "expansion";
+  m.kn = 1e8 * (D == 3 ? r_mean : thickness);
+  m.ks = 0.5 * m.kn;
+  m.friction = friction;
+  m.damping_ratio = 0.2;
+  m.density = kExpansionDensity;
+  MaterialTable mats;
+  mats.add(m);
+  SimulationConfig cfg;
+  cfg.contact_law = "linear";
+  cfg.local_damping = 0.7;
+  cfg.threads = threads;
+  cfg.track_energy = false;
+  cfg.guard.overlap_limit = 0.95;    // random placement may start with deep overlaps
+  cfg.guard.energy_runaway = false;  // growth pumps in energy that no ledger sees
+  Simulation<D> sim(mats, cfg);
+  sim.particles().thickness = thickness;
+  for (int d = 0; d < D; ++d) {
+    Wall<D> lo_wall, hi_wall;
+    lo_wall.name = std::string(1, "xyz"[d]) + "min";
+    hi_wall.name = std::string(1, "xyz"[d]) + "max";
+    lo_wall.normal = Vec<D>::Unit(d);
+    lo_wall.point = lo;
+    hi_wall.normal = -Vec<D>::Unit(d);
+    hi_wall.point = hi;
+    sim.addWall(lo_wall);
+    sim.addWall(hi_wall);
+  }
+  return sim;
+}
+
+template <int D>
+void growAndRelax(Simulation<D>& sim, double s0, const std::function<void(double)>& progress,
+                  const std::function<void()>& after_growth) {
+  // Grow by at most 2e-4 of the radius per step.
+  const double growth = std::log(1.0 / s0);
+  const auto grow_steps = static_cast<std::uint64_t>(std::max(500.0, std::ceil(growth / 2e-4)));
+  const double factor = std::exp(growth / static_cast<double>(grow_steps));
+  for (std::uint64_t k = 0; k < grow_steps; ++k) {
+    sim.scaleRadii(factor);
+    sim.step();
+    if (progress && k % 100 == 0) progress(0.5 * static_cast<double>(k) / grow_steps);
+  }
+  if (after_growth) {
+    after_growth();
+    sim.invalidateNeighbors();
+  }
+  // Relax until the overlaps left by growth are gone (a loose target) or the packing is
+  // in equilibrium (a target beyond jamming, where overlaps must stay).
+  const std::uint64_t relax_max = 40000;
+  for (std::uint64_t k = 0; k < relax_max; k += 100) {
+    sim.run(100);
+    if (progress) progress(0.5 + 0.5 * static_cast<double>(k) / relax_max);
+    if (sim.maxOverlapRatio() < 1e-3 || sim.unbalancedForceRatio() < 1e-3) break;
+  }
+}
+
+template <int D>
 Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report) {
   const std::string where = "packing";
   spec.sizes.validate();
@@ -207,66 +271,19 @@ Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report) {
   for (double& r : r0) r *= s0;
   const std::vector<Vec<D>> x0 = placeRandomly<D>(r0, out.lo, out.hi, rng);
 
-  // The expansion runs a soft linear-spring scene: the result is geometric, and a soft
-  // spring gives a long time step. Overlap per growth step relative to the radius is set by
-  // the growth rate, not by the stiffness.
-  Material m;
-  m.name = "expansion";
-  m.kn = 1e8 * (D == 3 ? r_mean : spec.thickness);
-  m.ks = 0.5 * m.kn;
-  m.friction = spec.friction;
-  m.damping_ratio = 0.2;
-  MaterialTable mats;
-  mats.add(m);
-  SimulationConfig cfg;
-  cfg.contact_law = "linear";
-  cfg.local_damping = 0.7;
-  cfg.threads = spec.threads;
-  cfg.track_energy = false;
-  cfg.guard.overlap_limit = 0.95;    // random placement may start with deep overlaps
-  cfg.guard.energy_runaway = false;  // growth pumps in energy that no ledger sees
-  Simulation<D> sim(mats, cfg);
-  sim.particles().thickness = spec.thickness;
+  Simulation<D> sim =
+      expansionScene<D>(r_mean, spec.thickness, spec.friction, spec.threads, out.lo, out.hi);
   for (std::size_t i = 0; i < spec.count; ++i) {
     ParticleSpec<D> p;
     p.position = x0[i];
     p.radius = r0[i];
-    p.density = m.density;
+    p.density = kExpansionDensity;
     sim.particles().add(p);
   }
-  for (int d = 0; d < D; ++d) {
-    Wall<D> lo_wall, hi_wall;
-    lo_wall.name = std::string(1, "xyz"[d]) + "min";
-    hi_wall.name = std::string(1, "xyz"[d]) + "max";
-    lo_wall.normal = Vec<D>::Unit(d);
-    lo_wall.point = out.lo;
-    hi_wall.normal = -Vec<D>::Unit(d);
-    hi_wall.point = out.hi;
-    sim.addWall(lo_wall);
-    sim.addWall(hi_wall);
-  }
-
-  // Grow by at most 2e-4 of the radius per step.
-  const double growth = std::log(1.0 / s0);
-  const auto grow_steps = static_cast<std::uint64_t>(std::max(500.0, std::ceil(growth / 2e-4)));
-  const double factor = std::exp(growth / static_cast<double>(grow_steps));
-  for (std::uint64_t k = 0; k < grow_steps; ++k) {
-    sim.scaleRadii(factor);
-    sim.step();
-    if (spec.progress && k % 100 == 0) spec.progress(0.5 * static_cast<double>(k) / grow_steps);
-  }
   auto& P = sim.particles();
-  for (std::size_t i = 0; i < P.size(); ++i) P.radius[i] = out.radii[P.slot_of[i]];
-  sim.invalidateNeighbors();
-
-  // Relax until the overlaps left by growth are gone (a loose target) or the packing is
-  // in equilibrium (a target beyond jamming, where overlaps must stay).
-  const std::uint64_t relax_max = 40000;
-  for (std::uint64_t k = 0; k < relax_max; k += 100) {
-    sim.run(100);
-    if (spec.progress) spec.progress(0.5 + 0.5 * static_cast<double>(k) / relax_max);
-    if (sim.maxOverlapRatio() < 1e-3 || sim.unbalancedForceRatio() < 1e-3) break;
-  }
+  growAndRelax<D>(sim, s0, spec.progress, [&] {
+    for (std::size_t i = 0; i < P.size(); ++i) P.radius[i] = out.radii[P.slot_of[i]];
+  });
 
   out.centers.resize(spec.count);
   for (std::size_t i = 0; i < P.size(); ++i) out.centers[P.slot_of[i]] = P.pos[i];
@@ -285,6 +302,12 @@ template std::vector<Vec<2>> placeRandomly<2>(const std::vector<double>&, const 
                                               const Vec<2>&, Rng&);
 template std::vector<Vec<3>> placeRandomly<3>(const std::vector<double>&, const Vec<3>&,
                                               const Vec<3>&, Rng&);
+template Simulation<2> expansionScene<2>(double, double, double, int, const Vec<2>&, const Vec<2>&);
+template Simulation<3> expansionScene<3>(double, double, double, int, const Vec<3>&, const Vec<3>&);
+template void growAndRelax<2>(Simulation<2>&, double, const std::function<void(double)>&,
+                              const std::function<void()>&);
+template void growAndRelax<3>(Simulation<3>&, double, const std::function<void(double)>&,
+                              const std::function<void()>&);
 template Packing<2> generatePacking<2>(const PackingSpec&, PackingReport*);
 template Packing<3> generatePacking<3>(const PackingSpec&, PackingReport*);
 

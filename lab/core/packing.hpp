@@ -85,4 +85,19 @@ std::vector<Vec<D>> placeRandomly(const std::vector<double>& r, const Vec<D>& lo
 template <int D>
 Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report = nullptr);
 
+// The pieces of radius expansion, shared by the sphere and the grain generators.
+template <int D>
+class Simulation;
+inline constexpr double kExpansionDensity = 2650.0;  // kg/m^3; the result is geometric
+// A soft linear-spring scene in the box [lo, hi] of walls (no particles yet).
+template <int D>
+Simulation<D> expansionScene(double r_mean, double thickness, double friction, int threads,
+                             const Vec<D>& lo, const Vec<D>& hi);
+// Grows every radius (and clump) by 1 / s0, at most 2e-4 of it per step; calls
+// `after_growth` (may be empty: e.g. to set the exact final radii); relaxes until the
+// overlaps are gone or the packing is in equilibrium. Progress goes 0..1.
+template <int D>
+void growAndRelax(Simulation<D>& sim, double s0, const std::function<void(double)>& progress,
+                  const std::function<void()>& after_growth);
+
 }  // namespace rocklab
