@@ -30,13 +30,14 @@ build: deps
 	cmake --preset $(PRESET)
 	cmake --build --preset $(PRESET)
 
-# Until the first rig exists: a packing, then the benchmark scene shared with the peers.
+# The main job: the quick oedometer protocol (a cemented sample formed under stress, then
+# loaded) into a fresh notebook, and its figure report.
 demo: build
 	@mkdir -p $(DEMO_DIR)
-	$(ROCKLAB) version
-	$(ROCKLAB) pack --dim 3 --n 3000 --dist phi --phi-mean -1 --phi-std 0.2 --d-min-mm 1 \
-	  --d-max-mm 4 --porosity 0.4 --seed 7 --out $(DEMO_DIR)/packing-3d.txt
-	$(ROCKLAB) bench --n 5000 --threads 1,2 --save-packing $(DEMO_DIR)/bench-packing.txt
+	@rm -f $(DEMO_DIR)/lab.sqlite
+	$(ROCKLAB) run protocols/oedometer-formed-under-stress-quick.toml --lab $(DEMO_DIR)/lab.sqlite
+	$(ROCKLAB) report 1 --lab $(DEMO_DIR)/lab.sqlite --out $(DEMO_DIR)/report
+	@echo "open $(DEMO_DIR)/report/index.html"
 
 test: build
 	ctest --preset $(PRESET)

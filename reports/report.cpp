@@ -67,6 +67,14 @@ FieldValues field(const std::string& which, const Frame& f, const Frame& first, 
       const auto& u = f.vel[i];
       v.values[i] = 1e3 * std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
     }
+  } else if (which == "grain") {
+    // Neighbouring grains in well-separated colours: ids spread by the golden ratio.
+    v.label = "grain (id, shuffled)";
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      if (i < f.cluster.size() && f.cluster[i] != 0xffffffffu) {
+        v.values[i] = std::fmod(0.618033988749895 * f.cluster[i], 1.0);
+      }
+    }
   } else if (which == "broken_bonds") {
     v.label = "broken bonds per particle";
     std::unordered_map<std::int64_t, double> count;
@@ -107,7 +115,7 @@ std::vector<BreakMark> breaksUpTo(const RunData& r, const SnapshotRow& snap) {
   std::vector<BreakMark> out;
   for (const EventRow& e : r.breaks) {
     if (e.stage != snap.stage || e.step > snap.step) continue;
-    out.push_back({{e.x, e.y, e.z}, e.mode == "tensile"});
+    out.push_back({{e.x, e.y, e.z}, e.mode == "tensile", e.intragranular});
   }
   return out;
 }
@@ -131,8 +139,10 @@ ReportSummary writeReport(const ReportOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   if (o.runs.empty()) throw std::invalid_argument("report: name at least one run");
   if (!fs::exists(o.lab)) throw std::invalid_argument("no lab notebook at '" + o.lab + "'");
-  if (o.field != "displacement" && o.field != "velocity" && o.field != "broken_bonds") {
-    throw std::invalid_argument("report: --field must be displacement, velocity or broken_bonds");
+  if (o.field != "displacement" && o.field != "velocity" && o.field != "broken_bonds" &&
+      o.field != "grain") {
+    throw std::invalid_argument(
+        "report: --field must be displacement, velocity, broken_bonds or grain");
   }
   fs::create_directories(o.out);
   notebook::Notebook nb(o.lab);

@@ -71,12 +71,13 @@ RunData loadRun(notebook::Notebook& nb, std::int64_t run) {
   }
   {
     auto s = db.prepare(
-        "SELECT step, coalesce(stage, ''), mode, x, y, z, particle_a, particle_b FROM events "
+        "SELECT step, coalesce(stage, ''), mode, x, y, z, particle_a, particle_b, "
+        "coalesce(granular, '') = 'intra' FROM events "
         "WHERE run_id = ? AND kind = 'bond_break' ORDER BY step");
     s.bind(1, run);
     while (s.step()) {
       r.breaks.push_back({static_cast<std::uint64_t>(s.integer(0)), s.text(1), s.text(2), s.real(3),
-                          s.real(4), s.real(5), s.integer(6), s.integer(7)});
+                          s.real(4), s.real(5), s.integer(6), s.integer(7), s.integer(8) != 0});
     }
   }
   return r;

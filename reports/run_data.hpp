@@ -31,6 +31,7 @@ struct EventRow {
   std::string stage, mode;
   double x, y, z;
   std::int64_t a, b;
+  bool intragranular;  // inside a grain (crushing) rather than between grains
 };
 
 struct RunData {

@@ -124,13 +124,15 @@ vtkNew<vtkActor> particleActor(const std::vector<std::array<double, 3>>& centres
   return actor;
 }
 
-// Broken bonds as small dark-edged markers: tensile vermillion, shear blue.
+// Broken bonds as small markers: between grains tensile vermillion, shear blue; inside
+// grains (crushing) larger, reddish purple (Okabe-Ito colours).
 void addBreaks(vtkRenderer* r, const std::vector<BreakMark>& breaks, double size,
                bool in_front_along_y, double y_front) {
-  for (const bool tensile : {true, false}) {
+  for (const int group : {0, 1, 2}) {  // tensile, shear, inside grains
+    const bool tensile = group == 0;
     vtkNew<vtkPoints> pts;
     for (const BreakMark& b : breaks) {
-      if (b.tensile != tensile) continue;
+      if (group == 2 ? !b.intragranular : (b.intragranular || b.tensile != tensile)) continue;
       pts->InsertNextPoint(b.position[0] * kMm, in_front_along_y ? y_front : b.position[1] * kMm,
                            b.position[2] * kMm);
     }
@@ -138,7 +140,7 @@ void addBreaks(vtkRenderer* r, const std::vector<BreakMark>& breaks, double size
     vtkNew<vtkPolyData> pd;
     pd->SetPoints(pts);
     vtkNew<vtkSphereSource> dot;
-    dot->SetRadius(size);
+    dot->SetRadius(group == 2 ? 1.6 * size : size);
     dot->SetThetaResolution(8);
     dot->SetPhiResolution(6);
     vtkNew<vtkGlyph3DMapper> m;
@@ -147,7 +149,9 @@ void addBreaks(vtkRenderer* r, const std::vector<BreakMark>& breaks, double size
     m->ScalarVisibilityOff();
     vtkNew<vtkActor> a;
     a->SetMapper(m);
-    if (tensile) {
+    if (group == 2) {
+      a->GetProperty()->SetColor(204 / 255.0, 121 / 255.0, 167 / 255.0);
+    } else if (tensile) {
       a->GetProperty()->SetColor(213 / 255.0, 94 / 255.0, 0.0);
     } else {
       a->GetProperty()->SetColor(0.0, 114 / 255.0, 178 / 255.0);
@@ -187,7 +191,7 @@ void addScaleBar(vtkRenderer* r, double x0, double width, double y, double z) {
 }
 
 void decorate(vtkRenderer* r, vtkLookupTable* lut, const FieldValues& field,
-              const std::string& title, bool have_breaks) {
+              const std::string& title, const std::vector<BreakMark>& breaks) {
   vtkNew<vtkScalarBarActor> bar;
   bar->SetLookupTable(lut);
   bar->SetTitle(field.label.c_str());
@@ -206,7 +210,12 @@ void decorate(vtkRenderer* r, vtkLookupTable* lut, const FieldValues& field,
   r->AddActor2D(bar);
   vtkNew<vtkTextActor> text;
   std::string t = title;
-  if (have_breaks) t += "\nbroken bonds: tensile (vermillion), shear (blue)";
+  if (!breaks.empty()) {
+    t += "\nbroken bonds: tensile (vermillion), shear (blue)";
+    const bool crushing = std::any_of(breaks.begin(), breaks.end(),
+                                      [](const BreakMark& b) { return b.intragranular; });
+    if (crushing) t += ", inside grains (purple)";
+  }
   text->SetInput(t.c_str());
   text->GetTextProperty()->SetColor(0.1, 0.1, 0.1);
   text->GetTextProperty()->SetFontSize(16);
@@ -283,7 +292,7 @@ void renderView(const Frame& f, const FieldValues& field, const std::vector<Brea
     sc.look({c[0] * kMm, c[1] * kMm, c[2] * kMm},
             {c[0] * kMm - 400.0, c[1] * kMm - 1000.0, c[2] * kMm + 350.0});
   }
-  decorate(sc.renderer, sc.lut, field, title, !breaks.empty());
+  decorate(sc.renderer, sc.lut, field, title, breaks);
   sc.canvas.savePng(png);
 }
 
@@ -312,7 +321,7 @@ void renderSlice(const Frame& f, const FieldValues& field, const std::vector<Bre
   std::ostringstream where;
   where.precision(4);
   where << title << ", section y = " << c[1] * kMm << " mm";
-  decorate(sc.renderer, sc.lut, field, where.str(), !breaks.empty());
+  decorate(sc.renderer, sc.lut, field, where.str(), breaks);
   sc.canvas.savePng(png);
 }
 

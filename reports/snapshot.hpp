@@ -15,6 +15,7 @@ namespace rocklab::reports {
 struct BreakMark {
   std::array<double, 3> position{};  // m
   bool tensile = true;
+  bool intragranular = false;  // a grain crushing: drawn apart from the cement's breaks
 };
 
 struct FieldValues {

@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
   rep->add_option("--lab", report.lab, "Lab notebook (SQLite)");
   rep->add_option("--out", report.out, "Output folder")->required();
   rep->add_option("--field", report.field, "Snapshot colouring")
-      ->check(CLI::IsMember({"displacement", "velocity", "broken_bonds"}));
+      ->check(CLI::IsMember({"displacement", "velocity", "broken_bonds", "grain"}));
   rep->add_option("--data", report.data_dir, "Folder holding paper.toml");
   rep->callback([&] {
     action = [&] {

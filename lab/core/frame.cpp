@@ -34,6 +34,7 @@ Frame captureFrame(const Simulation<D>& sim) {
   f.pos.resize(n);
   f.vel.resize(n);
   f.radius = P.radius;
+  f.cluster = P.cluster;
   f.spin.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     f.pos[i] = three<D>(P.pos[i]);
@@ -56,6 +57,7 @@ Frame captureFrame(const Simulation<D>& sim) {
 std::string encodeFrame(const Frame& f) {
   ArchiveWriter w;
   const_cast<Frame&>(f).visit(w);
+  w("cluster", f.cluster);
   std::string out(kMagic, sizeof kMagic);
   const std::uint32_t version = Frame::kVersion;
   out.append(reinterpret_cast<const char*>(&version), sizeof version);
@@ -68,13 +70,14 @@ Frame decodeFrame(const std::string& bytes, const std::string& where) {
   }
   std::uint32_t version;
   std::memcpy(&version, bytes.data() + 8, 4);
-  if (version != Frame::kVersion) {
+  if (version < 1 || version > Frame::kVersion) {
     throw CheckpointError("frame '" + where + "' has format version " + std::to_string(version) +
                           "; this rocklab reads version " + std::to_string(Frame::kVersion));
   }
   Frame f;
   ArchiveReader r(bytes.data() + 12, bytes.size() - 12);
   f.visit(r);
+  if (version >= 2) r("cluster", f.cluster);
   return f;
 }
 

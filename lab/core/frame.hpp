@@ -17,7 +17,8 @@ template <int D>
 class Simulation;
 
 struct Frame {
-  static constexpr std::uint32_t kVersion = 1;
+  // Version 2 added `cluster`; version 1 frames still read (without it).
+  static constexpr std::uint32_t kVersion = 2;
   int dimension = 3;
   std::uint64_t step = 0;
   double time = 0.0;
@@ -26,7 +27,8 @@ struct Frame {
   std::vector<std::uint32_t> slot;  // stable particle ids
   std::vector<std::array<double, 3>> pos, vel;
   std::vector<double> radius;
-  std::vector<double> spin;  // |spin| (rad/s)
+  std::vector<double> spin;            // |spin| (rad/s)
+  std::vector<std::uint32_t> cluster;  // grain of each particle (kNoCluster: none; v2)
 
   struct Link {
     std::uint32_t a = 0, b = 0;  // particle slots
