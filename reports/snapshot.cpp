@@ -252,7 +252,7 @@ struct Scene {
     cam->SetPosition(position[0], position[1], position[2]);
     cam->SetViewUp(0.0, 0.0, 1.0);
     renderer->ResetCamera();
-    cam->Zoom(1.1);
+    cam->Zoom(0.95);  // a margin above for the title lines
   }
 };
 
@@ -271,8 +271,9 @@ void renderView(const Frame& f, const FieldValues& field, const std::vector<Brea
     sc.renderer->AddActor(particleActor(centres, f.radius, field.values, sc.lut, true));
     std::vector<BreakMark> flat;
     for (const BreakMark& m : breaks)
-      flat.push_back({{m.position[0], 0.0, m.position[1]}, m.tensile});
-    addBreaks(sc.renderer, flat, 0.25 * sc.band * kMm, true, -0.01 * sc.band * kMm);
+      flat.push_back({{m.position[0], 0.0, m.position[1]}, m.tensile, m.intragranular});
+    // Marks half a mean radius across: a flat view has room for them.
+    addBreaks(sc.renderer, flat, 0.5 * sc.band * kMm, true, -0.01 * sc.band * kMm);
     addScaleBar(sc.renderer, b.lo[0] * kMm, width, -0.02 * width, b.lo[1] * kMm - 0.06 * width);
     sc.look({c[0] * kMm, 0.0, c[1] * kMm}, {c[0] * kMm, -1e3, c[1] * kMm});
   } else {

@@ -1,6 +1,7 @@
 #include "rigs/registry.hpp"
 
 #include "rigs/biaxial/biaxial.hpp"
+#include "rigs/biaxial/envelope.hpp"
 #include "rigs/common/specimen.hpp"
 #include "rigs/hydrostatic/hydrostatic.hpp"
 #include "rigs/oedometer/oedometer.hpp"
@@ -16,6 +17,10 @@ const std::vector<RigEntry>& rigTable() {
        "biaxial frame (2D) / triaxial cell (3D): confinement held by servo walls, axial strain "
        "rate through the peak; zero confinement is the UCS test",
        biaxial::declare, biaxial::validate, biaxial::run},
+      {"envelope",
+       "failure envelope: one formed sample, a biaxial / triaxial test at each confinement of a "
+       "sweep; critical points, Mohr-Coulomb line and end cap",
+       envelope::declare, envelope::validate, envelope::run},
       {"hydrostatic", "all walls servo-controlled to one stress, ramped up and optionally down",
        hydrostatic::declare, hydrostatic::validate, hydrostatic::run},
   };

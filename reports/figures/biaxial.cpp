@@ -1,56 +1,182 @@
-// The biaxial frame's and triaxial cell's figure: deviatoric stress, volumetric strain and
+// The biaxial frame's and triaxial cell's figures: deviatoric stress, volumetric strain and
 // cumulative broken bonds (cement and inside grains) against axial strain, one curve per
-// run, labelled with its confinement (cf. Li & Holt, section 2.3), with the paper's UCS.
+// test, labelled with its confinement (cf. Li & Holt, section 2.3); and for a confinement
+// sweep, the failure envelope with the Mohr-Coulomb line and the end cap (Figure 6).
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
 
 #include "reports/figures/figures.hpp"
 
-#include <sstream>
-
 namespace rocklab::reports {
 
-std::vector<Figure> biaxialFigures(const std::vector<const RunData*>& runs, const Paper& paper) {
+namespace {
+
+// One loading test inside a run: the biaxial rig's single test (no prefix) or each test of
+// an envelope sweep ("test1.", ...), found by its confinement result.
+struct Test {
+  const RunData* run;
+  std::string prefix, label;
+  double sigma3 = 0.0;  // MPa
+};
+
+std::vector<Test> testsOf(const RunData& r) {
+  std::vector<Test> out;
+  const std::string key = "confining_stress_MPa";
+  for (const auto& [name, q] : r.results) {
+    if (name.size() < key.size() || name.compare(name.size() - key.size(), key.size(), key) != 0)
+      continue;
+    const std::string prefix = name.substr(0, name.size() - key.size());
+    if (!prefix.empty() && prefix.back() != '.') continue;
+    std::ostringstream label;  // short: the legend sits on the chart
+    label << "run " << r.id << (prefix.empty() ? "" : " " + prefix.substr(0, prefix.size() - 1))
+          << ", sigma3 = " << q.value << " MPa";
+    out.push_back({&r, prefix, label.str(), q.value});
+  }
+  std::sort(out.begin(), out.end(),
+            [](const Test& a, const Test& b) { return a.sigma3 < b.sigma3; });
+  return out;
+}
+
+const Quantity* result(const RunData& r, const std::string& name) {
+  auto it = r.results.find(name);
+  return it == r.results.end() ? nullptr : &it->second;
+}
+
+Figure stressStrain(const std::vector<Test>& tests, const Paper& paper, const std::string& id) {
   Figure f;
-  f.id = "biaxial-stress-strain";
+  f.id = id;
   f.title = "Biaxial / triaxial tests: stress, volume change and damage against axial strain";
   f.caption =
       "Deviatoric stress (top), volumetric strain, compaction positive (middle), and cumulative "
       "broken bonds between grains (cement) and inside grains (crushing) (bottom) against "
-      "axial strain since the start of loading; one curve per run, labelled with its "
+      "axial strain since the start of loading; one curve per test, labelled with its "
       "confining stress. The paper's UCS is the marker at zero strain.";
   Panel stress{"axial strain (-)", "deviatoric stress (MPa)", {}};
   Panel volume{"axial strain (-)", "volumetric strain (-)", {}};
   Panel broken{"axial strain (-)", "broken bonds (cumulative)", {}};
-  for (const RunData* r : runs) {
-    std::ostringstream label;
-    label << r->label();
-    if (auto it = r->results.find("confining_stress_MPa"); it != r->results.end()) {
-      label << ", sigma3 = " << it->second.value << " MPa";
-    }
-    Series q{label.str(), {}, {}, false};
-    pair(*r, "axial_strain", "deviatoric_stress_MPa", q.x, q.y);
+  for (const Test& t : tests) {
+    const RunData& r = *t.run;
+    const std::string ea = t.prefix + "axial_strain";
+    Series q{t.label, {}, {}, false};
+    pair(r, ea, t.prefix + "deviatoric_stress_MPa", q.x, q.y);
     if (q.x.empty()) continue;
     stress.series.push_back(q);
-    Series v{label.str(), {}, {}, false};
-    pair(*r, "axial_strain", "volumetric_strain", v.x, v.y);
+    Series v{t.label, {}, {}, false};
+    pair(r, ea, t.prefix + "volumetric_strain", v.x, v.y);
     volume.series.push_back(v);
-    Series cement{label.str() + ": cement", {}, {}, false};
-    pair(*r, "axial_strain", "broken_bonds_total", cement.x, cement.y);
+    Series cement{t.label + ": cement", {}, {}, false};
+    pair(r, ea, t.prefix + "broken_bonds_total", cement.x, cement.y);
     broken.series.push_back(cement);
-    Series tensile{label.str() + ": in grains", {}, {}, false};
+    Series grains{t.label + ": in grains", {}, {}, false};
     Series shear{"", {}, {}, false};
-    pair(*r, "axial_strain", "broken_grain_bonds_tensile", tensile.x, tensile.y);
-    pair(*r, "axial_strain", "broken_grain_bonds_shear", shear.x, shear.y);
-    if (!tensile.x.empty() && shear.y.size() == tensile.y.size()) {
-      for (std::size_t k = 0; k < tensile.y.size(); ++k) tensile.y[k] += shear.y[k];
-      broken.series.push_back(tensile);
+    pair(r, ea, t.prefix + "broken_grain_bonds_tensile", grains.x, grains.y);
+    pair(r, ea, t.prefix + "broken_grain_bonds_shear", shear.x, shear.y);
+    if (!grains.x.empty() && shear.y.size() == grains.y.size()) {
+      for (std::size_t k = 0; k < grains.y.size(); ++k) grains.y[k] += shear.y[k];
+      broken.series.push_back(grains);
     }
   }
-  if (stress.series.empty()) return {};
+  if (stress.series.empty()) return f;
   if (const PaperNumber* ucs = paper.byKey("ucs")) {
     stress.series.push_back({"paper: UCS", {0.0}, {ucs->value}, true});
   }
   f.panels = {stress, volume, broken};
-  return {f};
+  return f;
+}
+
+// Figure 6: the critical points in the (p, q) plane, p = mean stress; the Mohr-Coulomb
+// line sigma_1 = N sigma_3 + UCS of the run's fit drawn through the same plane, and the
+// cap joining the compactive points (from the last dilatant one).
+Figure failureEnvelope(const RunData& r, const std::vector<Test>& tests) {
+  Figure f;
+  f.id = "failure-envelope-run" + std::to_string(r.id);
+  f.title = "Failure envelope, run " + std::to_string(r.id) + " " + r.protocol;
+  f.caption =
+      "Critical points of each test in the mean stress - deviatoric stress plane (Li & Holt, "
+      "Figure 6): the dilatant peak where the sample turns to dilate, the onset of "
+      "shear-enhanced compaction where it compacts beyond its elastic trend. The line is the "
+      "Mohr-Coulomb fit of the dilatant points (equation 1, friction angle and UCS in the "
+      "legend); the cap joins the compactive points.";
+  const int dim = r.param("protocol.dimension") == "2" ? 2 : 3;
+  Series dilatant{"dilatant critical points (peak)", {}, {}, true};
+  Series compactive{"compactive critical points (onset of compaction)", {}, {}, true};
+  Series cap{"end cap", {}, {}, false};
+  double last_dilatant_p = NAN, last_dilatant_q = NAN, sigma3_max = 0.0;
+  for (const Test& t : tests) {
+    sigma3_max = std::max(sigma3_max, t.sigma3);
+    const Quantity* q = result(r, t.prefix + "critical_deviatoric_stress_MPa");
+    const Quantity* p = result(r, t.prefix + "critical_mean_stress_MPa");
+    const Quantity* c = result(r, t.prefix + "critical_is_compaction");
+    if (!q || !p || !c) continue;
+    if (c->value > 0.5) {
+      if (cap.x.empty() && std::isfinite(last_dilatant_p)) {
+        cap.x.push_back(last_dilatant_p);
+        cap.y.push_back(last_dilatant_q);
+      }
+      compactive.x.push_back(p->value);
+      compactive.y.push_back(q->value);
+      cap.x.push_back(p->value);
+      cap.y.push_back(q->value);
+    } else {
+      dilatant.x.push_back(p->value);
+      dilatant.y.push_back(q->value);
+      last_dilatant_p = p->value, last_dilatant_q = q->value;
+    }
+  }
+  Panel pq{"mean stress p (MPa)", "deviatoric stress q (MPa)", {}};
+  const Quantity* phi = result(r, "friction_angle_deg");
+  const Quantity* ucs = result(r, "mohr_coulomb_ucs_MPa");
+  if (phi && ucs) {
+    const double s = std::sin(phi->value * std::numbers::pi / 180.0);
+    const double N = (1.0 + s) / (1.0 - s);  // tan^2(45 + phi/2)
+    std::ostringstream label;
+    label.precision(3);
+    label << "Mohr-Coulomb: phi = " << phi->value << " deg, UCS = " << ucs->value << " MPa";
+    Series line{label.str(), {}, {}, false};
+    for (int k = 0; k <= 20; ++k) {
+      const double s3 = sigma3_max * 1.1 * k / 20.0;
+      const double q = (N - 1.0) * s3 + ucs->value;
+      line.x.push_back(s3 + q / dim);
+      line.y.push_back(q);
+    }
+    pq.series.push_back(line);
+  }
+  for (Series* s : {&dilatant, &compactive, &cap}) {
+    if (!s->x.empty()) pq.series.push_back(*s);
+  }
+  if (dilatant.x.empty() && compactive.x.empty()) return f;
+  f.panels = {pq};
+  return f;
+}
+
+std::vector<Figure> loadingFigures(const std::vector<const RunData*>& runs, const Paper& paper,
+                                   const std::string& id) {
+  std::vector<Test> all;
+  std::vector<Figure> out;
+  for (const RunData* r : runs) {
+    const std::vector<Test> tests = testsOf(*r);
+    all.insert(all.end(), tests.begin(), tests.end());
+    if (tests.size() > 1) {
+      Figure e = failureEnvelope(*r, tests);
+      if (!e.panels.empty()) out.push_back(e);
+    }
+  }
+  Figure f = stressStrain(all, paper, id);
+  if (!f.panels.empty()) out.insert(out.begin(), f);
+  return out;
+}
+
+}  // namespace
+
+std::vector<Figure> biaxialFigures(const std::vector<const RunData*>& runs, const Paper& paper) {
+  return loadingFigures(runs, paper, "biaxial-stress-strain");
+}
+
+std::vector<Figure> envelopeFigures(const std::vector<const RunData*>& runs, const Paper& paper) {
+  return loadingFigures(runs, paper, "envelope-stress-strain");
 }
 
 }  // namespace rocklab::reports

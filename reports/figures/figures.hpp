@@ -25,5 +25,6 @@ const std::vector<FigureEntry>& figureTable();
 std::vector<Figure> oedometerFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> hydrostaticFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> biaxialFigures(const std::vector<const RunData*>& runs, const Paper& paper);
+std::vector<Figure> envelopeFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 
 }  // namespace rocklab::reports

@@ -1,9 +1,11 @@
 #include "rigs/common/localisation.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace rocklab::rigs {
 
@@ -103,6 +105,118 @@ Band findBand(const std::vector<std::array<double, 3>>& points, int dimension, i
   std::nth_element(counts.begin(), counts.begin() + 10, counts.end());
   best.contrast = static_cast<double>(best.points) / std::max(1.0, counts[10]);
   return best;
+}
+
+namespace {
+
+// The neighbours of each point within `reach`: a hash grid of cells `reach` wide.
+std::vector<std::vector<std::size_t>> neighbours(const std::vector<std::array<double, 3>>& x,
+                                                 int dimension, double reach) {
+  auto cell = [&](const std::array<double, 3>& p, int d) {
+    return static_cast<std::int64_t>(std::floor(p[d] / reach));
+  };
+  auto key = [](std::int64_t a, std::int64_t b, std::int64_t c) {
+    return (a * 73856093) ^ (b * 19349663) ^ (c * 83492791);
+  };
+  std::unordered_multimap<std::int64_t, std::size_t> grid;
+  grid.reserve(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    grid.emplace(key(cell(x[i], 0), cell(x[i], 1), dimension == 3 ? cell(x[i], 2) : 0), i);
+  }
+  std::vector<std::vector<std::size_t>> out(x.size());
+  const int dz = dimension == 3 ? 1 : 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const std::int64_t cx = cell(x[i], 0), cy = cell(x[i], 1),
+                       cz = dimension == 3 ? cell(x[i], 2) : 0;
+    for (int a = -1; a <= 1; ++a) {
+      for (int b = -1; b <= 1; ++b) {
+        for (int c = -dz; c <= dz; ++c) {
+          const auto [lo, hi] = grid.equal_range(key(cx + a, cy + b, cz + c));
+          for (auto it = lo; it != hi; ++it) {
+            const std::size_t j = it->second;
+            if (j == i) continue;
+            double d2 = 0.0;
+            for (int d = 0; d < dimension; ++d) d2 += (x[j][d] - x[i][d]) * (x[j][d] - x[i][d]);
+            if (d2 <= reach * reach) out[i].push_back(j);
+          }
+        }
+      }
+    }
+    // Hash collisions may list a point twice.
+    std::sort(out[i].begin(), out[i].end());
+    out[i].erase(std::unique(out[i].begin(), out[i].end()), out[i].end());
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<LocalStrain> localStrain(const std::vector<std::array<double, 3>>& before,
+                                     const std::vector<std::array<double, 3>>& after, int dimension,
+                                     double reach) {
+  if (before.size() != after.size()) {
+    throw std::invalid_argument("local strain: the two states hold different particles");
+  }
+  const int D = dimension;
+  const auto near = neighbours(before, D, reach);
+  std::vector<LocalStrain> out(before.size());
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    if (near[i].size() < static_cast<std::size_t>(D + 1)) continue;
+    // F = (sum du dx^T)(sum dx dx^T)^-1 over the neighbours (least squares).
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero(), B = Eigen::Matrix3d::Zero();
+    for (std::size_t j : near[i]) {
+      Eigen::Vector3d dx = Eigen::Vector3d::Zero(), du = Eigen::Vector3d::Zero();
+      for (int d = 0; d < D; ++d) {
+        dx[d] = before[j][d] - before[i][d];
+        du[d] = (after[j][d] - after[i][d]) - dx[d];
+      }
+      A += du * dx.transpose();
+      B += dx * dx.transpose();
+    }
+    const Eigen::MatrixXd Bd = B.topLeftCorner(D, D);
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(Bd);
+    if (!lu.isInvertible()) continue;  // neighbours on a line (plane): no gradient
+    const Eigen::MatrixXd F = A.topLeftCorner(D, D) * lu.inverse();
+    const Eigen::MatrixXd e = 0.5 * (F + F.transpose());
+    const double trace = e.trace();
+    out[i].compaction = -trace;
+    out[i].shear = (e - trace / D * Eigen::MatrixXd::Identity(D, D)).norm();
+  }
+  return out;
+}
+
+std::vector<std::array<double, 3>> strainedParticles(
+    const std::vector<std::array<double, 3>>& before,
+    const std::vector<std::array<double, 3>>& after, int dimension, double reach, double fraction,
+    StrainPart part) {
+  const std::vector<LocalStrain> strain = localStrain(before, after, dimension, reach);
+  // Particles within `reach` of the sample's faces have one-sided neighbourhoods and follow
+  // the platens and walls: they are left out (NaN), as are those not measured.
+  std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (const auto& x : before) {
+    for (int d = 0; d < dimension; ++d) {
+      lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
+    }
+  }
+  std::vector<double> e(strain.size(), NAN), ranked;
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    bool inside = strain[i].shear > 0.0 || strain[i].compaction != 0.0;
+    for (int d = 0; d < dimension; ++d) {
+      if (before[i][d] < lo[d] + reach || before[i][d] > hi[d] - reach) inside = false;
+    }
+    if (!inside) continue;
+    e[i] = part == StrainPart::Shear ? strain[i].shear : strain[i].compaction;
+    ranked.push_back(e[i]);
+  }
+  const auto k = static_cast<std::size_t>((1.0 - fraction) * static_cast<double>(ranked.size()));
+  if (ranked.empty() || k >= ranked.size()) return {};
+  std::nth_element(ranked.begin(), ranked.begin() + k, ranked.end());
+  const double threshold = ranked[k];
+  std::vector<std::array<double, 3>> out;
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    if (e[i] >= threshold && e[i] > 0.0) out.push_back(before[i]);  // NaN compares false
+  }
+  return out;
 }
 
 }  // namespace rocklab::rigs

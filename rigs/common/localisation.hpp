@@ -33,4 +33,29 @@ struct Band {
 Band findBand(const std::vector<std::array<double, 3>>& points, int dimension, int axial,
               double width);
 
+// The incremental strain field between two states of the same particles (`before`, `after`,
+// positions in the same order): each particle's strain is the symmetric part of the
+// least-squares displacement gradient of its neighbours within `reach` (m) of it in
+// `before` (at least `dimension` + 1 of them, else not measured: both parts 0).
+struct LocalStrain {
+  double shear = 0.0;       // Frobenius norm of the deviatoric part
+  double compaction = 0.0;  // minus the trace: volume lost per volume
+};
+std::vector<LocalStrain> localStrain(const std::vector<std::array<double, 3>>& before,
+                                     const std::vector<std::array<double, 3>>& after, int dimension,
+                                     double reach);
+
+// Which part of the strain a band is sought in: shear for dilatant (faulting) tests,
+// compaction for compactive ones (a compaction band is a zone of localised compaction).
+enum class StrainPart { Shear, Compaction };
+
+// The positions (in `before`) of the particles whose `part` of the local strain is in the
+// top `fraction` of those farther than `reach` from the sample's faces (near them,
+// neighbourhoods are one-sided and the platens drag the particles): where the deformation
+// concentrated, the points the band is sought in.
+std::vector<std::array<double, 3>> strainedParticles(
+    const std::vector<std::array<double, 3>>& before,
+    const std::vector<std::array<double, 3>>& after, int dimension, double reach, double fraction,
+    StrainPart part);
+
 }  // namespace rocklab::rigs

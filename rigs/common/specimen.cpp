@@ -20,9 +20,15 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
   range(s.integer("protocol.seed", 1, "seed of the packing and the bond strengths"), 0, false, 9e15,
         false);
 
-  s.choice("sample.kind", {"spheres", "grains"}, "spheres",
+  s.choice("sample.kind", {"spheres", "grains", "clumps"}, "spheres",
            "spheres: one disk or sphere per grain; grains: breakable superparticles, pebbles "
-           "joined by intragranular bonds (grains.*, grain_bonds.*; Li & Holt section 2.2)");
+           "joined by intragranular bonds (grains.*, grain_bonds.*; Li & Holt section 2.2); "
+           "clumps: the same shapes as rigid bodies (grains.*, clumps.*)");
+  range(s.real("clumps.break_stress_MPa", "MPa", 1e6, 0.0,
+               "a clump breaks into its pebbles when F / d^2 of its largest pebble contact "
+               "force F reaches this (d: its equivalent diameter; McDowell & Bolton 1998); "
+               "0: unbreakable"),
+        0, false, 1e5, false);
   range(s.integer("sample.count", std::nullopt, "number of particles (grains for kind = grains)"),
         2, false, 5e7, false);
   range(s.integer("grains.pebbles_across", 4, "pebbles along a grain's long axis"), 2, false, 20,
@@ -270,6 +276,8 @@ Specimen<D> Specimen<D>::branch() const {
   b.grain_kind = grain_kind;
   b.grain_bonds = grain_bonds;
   b.grain_aspect_ratios = grain_aspect_ratios;
+  b.clumps = clumps;
+  b.clump_breaks = clump_breaks;
   b.fragments_reference = fragments_reference;
   b.record_every = record_every;
   b.snapshot_every = snapshot_every;
@@ -321,7 +329,7 @@ Packing<D> makePacking(const Settings& s, RunControl& control, std::vector<std::
   const auto seed = static_cast<std::uint64_t>(s.integer("protocol.seed"));
   const int threads = static_cast<int>(s.integer("numerics.threads"));
   auto progress = [&](double f) { control.tick("packing", 0, f, "growth to the porosity"); };
-  if (s.text("sample.kind") == "grains") {
+  if (s.text("sample.kind") != "spheres") {
     GrainPackingSpec g;
     g.grains = count;
     g.sizes = sizes(s);
@@ -334,7 +342,17 @@ Packing<D> makePacking(const Settings& s, RunControl& control, std::vector<std::
     g.seed = seed;
     g.threads = threads;
     g.progress = progress;
-    GrainPacking<D> out = generateGrainPacking<D>(g);
+    PackingReport report;
+    GrainPacking<D> out = generateGrainPacking<D>(g, &report);
+    // Rigid grains jam looser than spheres (in 3D near 0.5 porosity before formation): a
+    // target below that ends the growth with overlaps the first step would refuse.
+    if (report.max_overlap > 0.5 * s.real("numerics.overlap_limit")) {
+      protocol::fail(s, "sample.porosity_initial",
+                     "is denser than these grains pack to by growth: it ended with overlaps of " +
+                         std::to_string(report.max_overlap) +
+                         " of a pebble radius; raise it (formation densifies the sample "
+                         "afterwards; 3D grains pack to about 0.5)");
+    }
     grain = std::move(out.grain);
     aspect_ratios = std::move(out.grain_aspect_ratio);
     return std::move(out.pebbles);
@@ -381,15 +399,29 @@ Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
   sp.sim = std::make_unique<Simulation<D>>(materials(s, s.real("formation.friction")), cfg);
   sp.sim->particles().thickness = spec.thickness;
   sp.sim->rng().reseed(spec.seed ^ 0x5eedb0d5ull);  // the bond strengths' own stream
+  std::vector<ParticleId> ids;
   for (std::size_t i = 0; i < p.centers.size(); ++i) {
     ParticleSpec<D> ps;
     ps.position = p.centers[i];
     ps.radius = p.radii[i];
     ps.density = sp.density;
     if (!grain.empty()) ps.cluster = grain[i];
-    sp.sim->particles().add(ps);
+    ids.push_back(sp.sim->particles().add(ps));
   }
-  if (!grain.empty()) {
+  if (s.text("sample.kind") == "clumps") {
+    // Rigid grains: each grain's pebbles (consecutive in the packing) one clump.
+    const double strength = s.si("clumps.break_stress_MPa");
+    std::vector<ParticleId> pebbles;
+    for (std::size_t i = 0; i < grain.size(); ++i) {
+      pebbles.push_back(ids[i]);
+      if (i + 1 == grain.size() || grain[i + 1] != grain[i]) {
+        sp.sim->addClump(pebbles, strength);
+        pebbles.clear();
+      }
+    }
+    sp.clumps = true;
+    sp.grain_aspect_ratios = std::move(aspect_ratios);
+  } else if (!grain.empty()) {
     // The grains are whole from the start: their intragranular bonds go in now, unloaded.
     BondKind k;
     k.name = "grain";
@@ -551,25 +583,46 @@ double inertialNumber(const Specimen<D>& sp, double strain_rate) {
   return std::abs(strain_rate) * 2.0 * sp.mean_radius * std::sqrt(sp.density / p);
 }
 
+namespace {
+
+// The fields every break event has: when, where, in which stage.
+template <int D>
+EventRecord breakEvent(std::uint64_t step, double time, const Vec<D>& position,
+                       const std::string& stage, const char* kind) {
+  EventRecord e;
+  e.step = step;
+  e.time = time;
+  e.stage = stage;
+  e.kind = kind;
+  e.x = position[0];
+  e.y = position[1];
+  if constexpr (D == 3) e.z = position[2];
+  return e;
+}
+
+}  // namespace
+
 template <int D>
 void recordBreaks(Specimen<D>& sp, Recorder& rec, const std::string& stage) {
   const auto& kinds = sp.sim->bondKinds();
   for (const BondBreak<D>& b : sp.sim->takeBondBreaks()) {
-    EventRecord e;
-    e.step = b.step;
-    e.time = b.time;
-    e.stage = stage;
-    e.kind = "bond_break";
+    EventRecord e = breakEvent<D>(b.step, b.time, b.position, stage, "bond_break");
     e.mode = b.mode == BondBreakMode::Tensile ? "tensile" : "shear";
     e.granular = kinds[b.kind].intragranular ? "intra" : "inter";
-    e.x = b.position[0];
-    e.y = b.position[1];
-    if constexpr (D == 3) e.z = b.position[2];
     if (sp.keep_break_positions) sp.break_positions.push_back({e.x, e.y, e.z});
     e.particle_a = b.a.slot;
     e.particle_b = b.b.slot;
     e.value = b.stress;
     rec.event(e);
+  }
+  for (const ClumpBreak<D>& b : sp.sim->takeClumpBreaks()) {
+    EventRecord e = breakEvent<D>(b.step, b.time, b.position, stage, "clump_break");
+    e.mode = "crushing";
+    e.granular = "intra";
+    e.particle_a = b.clump;
+    e.value = b.stress;
+    rec.event(e);
+    ++sp.clump_breaks;
   }
 }
 

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 #include "lab/protocol/params.hpp"
 #include "rigs/common/experiment.hpp"
@@ -21,6 +22,17 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
 // Checks across keys of the shared sections (throws protocol::ProtocolError).
 void validateCommon(const Settings& s);
 
+// Runs `body(std::integral_constant<int, D>{})` for the protocol's dimension: a rig's
+// entry point picks its 2D or 3D instantiation in one line.
+template <class Body>
+void byDimension(const Settings& s, Body&& body) {
+  if (s.integer("protocol.dimension") == 2) {
+    body(std::integral_constant<int, 2>{});
+  } else {
+    body(std::integral_constant<int, 3>{});
+  }
+}
+
 template <int D>
 struct Specimen {
   std::unique_ptr<Simulation<D>> sim;
@@ -34,6 +46,9 @@ struct Specimen {
   std::optional<std::uint8_t> grain_kind;
   CementReport grain_bonds;
   std::vector<double> grain_aspect_ratios;
+  // Rigid grains (sample.kind = clumps) and how many broke into their pebbles so far.
+  bool clumps = false;
+  std::uint64_t clump_breaks = 0;
   std::uint64_t record_every = 500;
   std::uint64_t snapshot_every = 0;  // 0: only at the ends of stages
   // Bonds broken before the measured stage (formation, coring) are not counted in it:

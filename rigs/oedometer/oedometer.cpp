@@ -278,11 +278,7 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
 }  // namespace
 
 void run(const Settings& s, Recorder& rec, RunControl& control) {
-  if (s.integer("protocol.dimension") == 2) {
-    runDimension<2>(s, rec, control);
-  } else {
-    runDimension<3>(s, rec, control);
-  }
+  byDimension(s, [&](auto dim) { runDimension<dim.value>(s, rec, control); });
 }
 
 }  // namespace rocklab::rigs::oedometer

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -63,6 +64,87 @@ TEST(Localisation, UniformDamageHasNoContrast) {
   for (int k = 0; k < 600; ++k) p.push_back({rng.uniform(0, 0.01), rng.uniform(0, 0.02), 0});
   EXPECT_LT(findBand(p, 2, 1, 0.001).contrast, 2.0);
   EXPECT_THROW(findBand({{0, 0, 0}}, 2, 1, 0.001), std::invalid_argument);
+}
+
+// A lattice under a homogeneous strain: every interior particle measures it exactly.
+TEST(StrainField, AHomogeneousStrainIsMeasuredExactly) {
+  std::vector<std::array<double, 3>> before, after;
+  const double exx = -1e-3, eyy = 2e-3, exy = 5e-4;  // symmetric gradient
+  for (int i = 0; i < 20; ++i) {
+    for (int j = 0; j < 40; ++j) {
+      const double x = 1e-4 * (i + 0.5 * (j % 2)), y = 0.866e-4 * j;
+      before.push_back({x, y, 0});
+      after.push_back({x + exx * x + exy * y, y + exy * x + eyy * y, 0});
+    }
+  }
+  const std::vector<LocalStrain> e = localStrain(before, after, 2, 1.5e-4);
+  // Deviatoric part: exx - m, eyy - m with m the mean; compaction: minus the trace.
+  const double m = 0.5 * (exx + eyy);
+  const double shear = std::sqrt((exx - m) * (exx - m) + (eyy - m) * (eyy - m) + 2 * exy * exy);
+  std::size_t unmeasured = 0;  // corners: fewer than three neighbours
+  for (std::size_t k = 0; k < e.size(); ++k) {
+    if (e[k].shear == 0.0) {
+      ++unmeasured;
+      continue;
+    }
+    EXPECT_NEAR(e[k].shear, shear, 1e-12) << k;
+    EXPECT_NEAR(e[k].compaction, -(exx + eyy), 1e-12) << k;
+  }
+  EXPECT_LE(unmeasured, 2u);
+  EXPECT_THROW(localStrain(before, {}, 2, 1e-4), std::invalid_argument);
+}
+
+// Two blocks sliding past each other along a band at 30 degrees to y (sigma_1): the most
+// strained particles lie in the band and the detector finds its angle; the platens (the
+// faces) are left out.
+TEST(StrainField, TheMostStrainedParticlesLieInTheSlipBand) {
+  Rng rng(11);
+  const double angle = 30.0 * kDeg;
+  const std::array<double, 2> t{std::sin(angle), std::cos(angle)};   // along the band
+  const std::array<double, 2> n{std::cos(angle), -std::sin(angle)};  // its normal
+  std::vector<std::array<double, 3>> before, after;
+  for (int k = 0; k < 4000; ++k) {
+    const double x = rng.uniform(0, 0.01), y = rng.uniform(0, 0.02);
+    const double d = (x - 0.005) * n[0] + (y - 0.01) * n[1];  // signed distance to the band
+    // Slip of 2e-5 m across a band 0.3 mm thick, a smooth ramp inside it.
+    const double slip = 2e-5 * std::clamp(d / 0.0003 + 0.5, 0.0, 1.0);
+    before.push_back({x, y, 0});
+    // with a background jitter, as in any granular sample, 1% of the slip
+    after.push_back(
+        {x + slip * t[0] + 2e-7 * rng.normal(), y + slip * t[1] + 2e-7 * rng.normal(), 0});
+  }
+  const auto pts = strainedParticles(before, after, 2, 3e-4, 0.05, StrainPart::Shear);
+  ASSERT_GT(pts.size(), 150u);  // 5% of the ~3,500 particles off the faces
+  std::size_t in_band = 0;      // the rest: the jitter's strongest spots
+  for (const auto& p : pts) {
+    in_band += std::abs((p[0] - 0.005) * n[0] + (p[1] - 0.01) * n[1]) < 0.00015 + 3e-4;
+    EXPECT_GE(p[0], 3e-4);  // off the faces
+    EXPECT_LE(p[1], 0.02 - 3e-4);
+  }
+  EXPECT_GT(in_band, pts.size() / 2);
+  EXPECT_NEAR(findBand(pts, 2, 1, 0.001).angle_to_axial_deg, 30.0, 2.0);
+}
+
+// A layer normal to sigma_1 (y) that compacts while the rest moves rigidly: the most
+// compacted particles lie in it, and the band found is a compaction band.
+TEST(StrainField, TheMostCompactedParticlesLieInTheCompactionBand) {
+  Rng rng(13);
+  std::vector<std::array<double, 3>> before, after;
+  for (int k = 0; k < 4000; ++k) {
+    const double x = rng.uniform(0, 0.01), y = rng.uniform(0, 0.02);
+    // Shortening of 2e-5 m inside 0.3 mm about y = 12 mm: the part above moves down.
+    const double dy = -2e-5 * std::clamp((y - 0.012) / 0.0003 + 0.5, 0.0, 1.0);
+    before.push_back({x, y, 0});
+    after.push_back({x + 2e-7 * rng.normal(), y + dy + 2e-7 * rng.normal(), 0});
+  }
+  const auto pts = strainedParticles(before, after, 2, 3e-4, 0.05, StrainPart::Compaction);
+  ASSERT_GT(pts.size(), 150u);  // 5% of the ~3,500 particles off the faces
+  std::size_t in_band = 0;
+  for (const auto& p : pts) in_band += std::abs(p[1] - 0.012) < 0.00015 + 3e-4;
+  EXPECT_GT(in_band, pts.size() / 2);
+  const Band b = findBand(pts, 2, 1, 0.001);
+  EXPECT_NEAR(b.angle_to_axial_deg, 90.0, 2.0);
+  EXPECT_TRUE(b.is_compaction());
 }
 
 }  // namespace
