@@ -658,7 +658,11 @@ void recordState(Specimen<D>& sp, Recorder& rec, const std::string& prefix,
     put("broken_grain_bonds_tensile",
         static_cast<double>(sp.brokenInGrains(BondBreakMode::Tensile)));
     put("broken_grain_bonds_shear", static_cast<double>(sp.brokenInGrains(BondBreakMode::Shear)));
-    put("crushed_grains", static_cast<double>(sp.crushedGrains()));
+    // Fragments: connected components of intact intragranular bonds, over all grains.
+    const auto fragments = grainFragments<D>(sim.particles(), sim.bonds(), sim.bondKinds());
+    put("crushed_grains", static_cast<double>(crushedGrains(sp.fragments_reference, fragments)));
+    put("grain_fragments",
+        static_cast<double>(std::accumulate(fragments.begin(), fragments.end(), std::size_t{0})));
   }
   put("unbalanced_force_ratio", sim.unbalancedForceRatio());
   if (strain_rate != 0.0) put("inertial_number", inertialNumber(sp, strain_rate));
