@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 #include "rigs/biaxial/loading.hpp"
@@ -93,21 +94,14 @@ std::vector<std::array<double, 3>> slotPositions(const Simulation<D>& sim) {
   return out;
 }
 
-// A band (rigs/common/localisation.hpp) to the notebook as `prefix + name + "_..."`.
+// A band (rigs/common/localisation.hpp) to the notebook as `prefix + name + "_..."`;
+// `what` says in which points it was found.
 template <int D>
-void reportBand(const Specimen<D>& sp, const Settings& s,
-                const std::vector<std::array<double, 3>>& points, const std::string& prefix,
+void reportBand(const Specimen<D>& sp, const Band& b, const std::string& prefix,
                 const std::string& name, const std::string& what, Recorder& rec) {
   const auto& sim = *sp.sim;
   // Messages name the test of a sweep: "test2: ..." (prefix "test2.").
   const std::string who = prefix.empty() ? "" : prefix.substr(0, prefix.size() - 1) + ": ";
-  if (points.size() < 10) {
-    rec.message(sim.steps(), sim.time(), "info",
-                who + "fewer than 10 " + what + ": no band to find in them");
-    return;
-  }
-  const double width = s.real("analysis.band_width_radii") * sp.mean_radius;
-  const Band b = findBand(points, D, Specimen<D>::kAxial, width);
   const std::string p = prefix + name;
   rec.result(p + "_angle_deg", b.angle_to_axial_deg, "deg");
   rec.result(p + "_is_compaction", b.is_compaction() ? 1.0 : 0.0, "");
@@ -119,6 +113,14 @@ void reportBand(const Specimen<D>& sp, const Settings& s,
                   " band at " + fmt(b.angle_to_axial_deg) + " deg to sigma_1, " +
                   fmt(b.thickness * 1e3) + " mm thick, " + fmt(b.contrast) +
                   " times the mean density");
+}
+
+template <int D>
+void noBand(const Specimen<D>& sp, const std::string& prefix, const std::string& what,
+            Recorder& rec) {
+  const std::string who = prefix.empty() ? "" : prefix.substr(0, prefix.size() - 1) + ": ";
+  rec.message(sp.sim->steps(), sp.sim->time(), "info",
+              who + "fewer than 10 " + what + ": no band to find in them");
 }
 
 }  // namespace
@@ -272,24 +274,56 @@ TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
                     "or lower the loading rate");
   }
   warnIfNotQuasiStatic(sim, s, rec, stage, unbalanced_sum / records, inertial_max);
-  // The band: in the strain field from the last state before the critical point to the end
-  // (the localised deformation), and in the breaks from the critical point on.
+  // The band: in the strain field after the critical point, and in the breaks from it on.
+  // A dilatant test localises shear, a compactive one compaction: the band is sought in
+  // that part of the strain (a compaction band is a zone of localised compaction). A shear
+  // band, once formed, slips in place: its field is the whole post-critical range. A
+  // compaction band migrates along the sample (Olsson 1999; Baud et al. 2004), sharp in
+  // its own strain window and smeared over the whole range: its field is, of the whole
+  // range and each twentieth of the strain range after the critical point, the one with
+  // the most contrasted band.
+  const bool compactive = out.critical.found && out.critical.compactive;
+  const StrainPart part = compactive ? StrainPart::Compaction : StrainPart::Shear;
+  const double width = s.real("analysis.band_width_radii") * sp.mean_radius;
   std::size_t from = 0;
   while (from + 1 < states.size() && states[from + 1].first <= field_from) ++from;
-  put("band_strain_from", states[from].first, "");
-  // A dilatant test localises shear, a compactive one compaction: the band is sought in
-  // that part of the strain (a compaction band is a zone of localised compaction).
-  const bool compactive = out.critical.found && out.critical.compactive;
-  const auto strained =
-      strainedParticles(states[from].second, slotPositions(sim), D, 4.0 * sp.mean_radius,
-                        s.real("analysis.strained_fraction"),
-                        compactive ? StrainPart::Compaction : StrainPart::Shear);
+  states.emplace_back(frame.strain(ax), slotPositions(sim));
+  struct Window {
+    double from = 0.0, to = 0.0;
+    Band band;
+  };
+  std::optional<Window> best;
+  auto consider = [&](std::size_t a, std::size_t b) {
+    const auto pts = strainedParticles(states[a].second, states[b].second, D, 4.0 * sp.mean_radius,
+                                       s.real("analysis.strained_fraction"), part);
+    if (pts.size() < 10) return;
+    const Band band = findBand(pts, D, ax, width);
+    if (!best || band.contrast > best->band.contrast) {
+      best = Window{states[a].first, states[b].first, band};
+    }
+  };
+  const std::size_t last = states.size() - 1;
+  consider(from, last);
+  if (compactive) {
+    for (std::size_t k = from; k + 1 < last; ++k) consider(k, k + 1);
+  }
   put("band_in_compaction_field", compactive ? 1.0 : 0.0, "");
-  reportBand(sp, s, strained, prefix, "band",
-             compactive ? "most compacted particles" : "most sheared particles", rec);
+  const std::string field = compactive ? "most compacted particles" : "most sheared particles";
+  if (best) {
+    put("band_strain_from", best->from, "");
+    put("band_strain_to", best->to, "");
+    reportBand(sp, best->band, prefix, "band", field, rec);
+  } else {
+    noBand(sp, prefix, field, rec);
+  }
   const std::vector<std::array<double, 3>> breaks(sp.break_positions.begin() + band_first,
                                                   sp.break_positions.end());
-  reportBand(sp, s, breaks, prefix, "break_band", "bond breaks from the critical point on", rec);
+  const std::string from_critical = "bond breaks from the critical point on";
+  if (breaks.size() >= 10) {
+    reportBand(sp, findBand(breaks, D, ax, width), prefix, "break_band", from_critical, rec);
+  } else {
+    noBand(sp, prefix, from_critical, rec);
+  }
   return out;
 }
 

@@ -219,6 +219,9 @@ TEST(QuickProtocols, HighConfinementBreaksInShearAndCrushesGrains) {
   EXPECT_GT(result(low, "band_angle_deg"), 20.0);
   EXPECT_LT(result(low, "band_angle_deg"), 50.0);
   EXPECT_EQ(result(high, "critical_is_compaction"), 1.0);
+  EXPECT_EQ(result(high, "band_in_compaction_field"), 1.0);
+  EXPECT_EQ(result(high, "band_is_compaction"), 1.0);  // within 20 deg of normal to sigma_1
+  EXPECT_GT(result(high, "band_contrast"), 3.0);       // a band, not diffuse compaction
   // Every break is an event with its kind: intragranular breaks are the crushing.
   EXPECT_EQ(std::stod(scalar(high,
                              "SELECT count(*) FROM events WHERE granular = 'intra' AND "
@@ -251,6 +254,10 @@ TEST(QuickProtocols, EnvelopeSweepGivesMohrCoulombLineAndCap) {
   EXPECT_LT(result(n, "friction_angle_deg"), 50.0);
   EXPECT_NEAR(result(n, "mohr_coulomb_ucs_MPa"), result(n, "test1.ucs_MPa"),
               0.3 * result(n, "test1.ucs_MPa"));
+  // The bands of Figures 4 and 5 in the sweep: inclined at 4 MPa (measured 21 deg),
+  // near-normal at 18 MPa (measured 74.75 deg, contrast 9.7).
+  EXPECT_EQ(result(n, "test2.band_is_compaction"), 0.0);
+  EXPECT_EQ(result(n, "test4.band_is_compaction"), 1.0);
   // The cap: below the Mohr-Coulomb line at the highest confinement.
   const double phi = result(n, "friction_angle_deg") * M_PI / 180.0;
   const double N = (1 + std::sin(phi)) / (1 - std::sin(phi));
