@@ -95,13 +95,13 @@ std::vector<std::array<double, 3>> slotPositions(const Simulation<D>& sim) {
 }
 
 // A band (rigs/common/localisation.hpp) to the notebook as `prefix + name + "_..."`;
-// `what` says in which points it was found.
+// `what` says in which points it was found;
+// `who` names the test of a sweep in messages ("test2: ").
 template <int D>
 void reportBand(const Specimen<D>& sp, const Band& b, const std::string& prefix,
-                const std::string& name, const std::string& what, Recorder& rec) {
+                const std::string& who, const std::string& name, const std::string& what,
+                Recorder& rec) {
   const auto& sim = *sp.sim;
-  // Messages name the test of a sweep: "test2: ..." (prefix "test2.").
-  const std::string who = prefix.empty() ? "" : prefix.substr(0, prefix.size() - 1) + ": ";
   const std::string p = prefix + name;
   rec.result(p + "_angle_deg", b.angle_to_axial_deg, "deg");
   rec.result(p + "_is_compaction", b.is_compaction() ? 1.0 : 0.0, "");
@@ -116,9 +116,7 @@ void reportBand(const Specimen<D>& sp, const Band& b, const std::string& prefix,
 }
 
 template <int D>
-void noBand(const Specimen<D>& sp, const std::string& prefix, const std::string& what,
-            Recorder& rec) {
-  const std::string who = prefix.empty() ? "" : prefix.substr(0, prefix.size() - 1) + ": ";
+void noBand(const Specimen<D>& sp, const std::string& who, const std::string& what, Recorder& rec) {
   rec.message(sp.sim->steps(), sp.sim->time(), "info",
               who + "fewer than 10 " + what + ": no band to find in them");
 }
@@ -238,7 +236,7 @@ TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
         "");
     put("crushed_grains", static_cast<double>(sp.crushedGrains()), "");
   }
-  if (sp.clumps) {  // a rigid grain crushes whole, into its pebbles
+  if (sim.clumps().size() > 0) {  // a rigid grain crushes whole, into its pebbles
     put("crushed_grains", static_cast<double>(sp.clump_breaks - clumps_broken_before), "");
   }
   const double records = static_cast<double>(std::max<std::size_t>(1, curve.q.size()));
@@ -248,16 +246,14 @@ TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
 
   TestOutcome out;
   out.sigma3 = sigma3;
-  out.peak_q = peak;
   out.critical = criticalPoint(curve);
-  // p = (sigma_1 + sigma_2 [+ sigma_3]) / D with the lateral stresses at sigma_3.
-  out.critical_mean_stress = sigma3 + out.critical.q / D;
   std::size_t band_first = 0;
   double field_from = 0.0;
   if (out.critical.found) {
     put("critical_is_compaction", out.critical.compactive ? 1.0 : 0.0, "");
     put("critical_deviatoric_stress_MPa", out.critical.q / 1e6, "MPa");
-    put("critical_mean_stress_MPa", out.critical_mean_stress / 1e6, "MPa");
+    // p = (sigma_1 + sigma_2 [+ sigma_3]) / D with the lateral stresses at sigma_3.
+    put("critical_mean_stress_MPa", (sigma3 + out.critical.q / D) / 1e6, "MPa");
     put("critical_axial_strain", out.critical.axial_strain, "");
     band_first = breaks_at[out.critical.index];
     field_from = out.critical.axial_strain;
@@ -312,17 +308,17 @@ TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
   if (best) {
     put("band_strain_from", best->from, "");
     put("band_strain_to", best->to, "");
-    reportBand(sp, best->band, prefix, "band", field, rec);
+    reportBand(sp, best->band, prefix, who, "band", field, rec);
   } else {
-    noBand(sp, prefix, field, rec);
+    noBand(sp, who, field, rec);
   }
   const std::vector<std::array<double, 3>> breaks(sp.break_positions.begin() + band_first,
                                                   sp.break_positions.end());
   const std::string from_critical = "bond breaks from the critical point on";
   if (breaks.size() >= 10) {
-    reportBand(sp, findBand(breaks, D, ax, width), prefix, "break_band", from_critical, rec);
+    reportBand(sp, findBand(breaks, D, ax, width), prefix, who, "break_band", from_critical, rec);
   } else {
-    noBand(sp, prefix, from_critical, rec);
+    noBand(sp, who, from_critical, rec);
   }
   return out;
 }

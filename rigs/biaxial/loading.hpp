@@ -16,10 +16,8 @@ void declareLoading(protocol::Schema& s);
 void validateLoading(const Settings& s);
 
 struct TestOutcome {
-  double sigma3 = 0.0;                // Pa
-  double peak_q = 0.0;                // Pa
-  CriticalPoint critical;             // q in Pa
-  double critical_mean_stress = 0.0;  // Pa, p at the critical point
+  double sigma3 = 0.0;     // Pa
+  CriticalPoint critical;  // q in Pa
 };
 
 // The sample's measured make-up (particles, grains and their aspect ratios) as results.

@@ -276,7 +276,6 @@ Specimen<D> Specimen<D>::branch() const {
   b.grain_kind = grain_kind;
   b.grain_bonds = grain_bonds;
   b.grain_aspect_ratios = grain_aspect_ratios;
-  b.clumps = clumps;
   b.clump_breaks = clump_breaks;
   b.fragments_reference = fragments_reference;
   b.record_every = record_every;
@@ -419,7 +418,6 @@ Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
         pebbles.clear();
       }
     }
-    sp.clumps = true;
     sp.grain_aspect_ratios = std::move(aspect_ratios);
   } else if (!grain.empty()) {
     // The grains are whole from the start: their intragranular bonds go in now, unloaded.

@@ -46,8 +46,7 @@ struct Specimen {
   std::optional<std::uint8_t> grain_kind;
   CementReport grain_bonds;
   std::vector<double> grain_aspect_ratios;
-  // Rigid grains (sample.kind = clumps) and how many broke into their pebbles so far.
-  bool clumps = false;
+  // Rigid grains (sample.kind = clumps) broken into their pebbles so far.
   std::uint64_t clump_breaks = 0;
   std::uint64_t record_every = 500;
   std::uint64_t snapshot_every = 0;  // 0: only at the ends of stages
