@@ -80,6 +80,13 @@ RunData loadRun(notebook::Notebook& nb, std::int64_t run) {
                           s.real(4), s.real(5), s.integer(6), s.integer(7), s.integer(8) != 0});
     }
   }
+  {
+    auto s = db.prepare(
+        "SELECT coalesce(stage, ''), x, y, z, value FROM events "
+        "WHERE run_id = ? AND kind = 'pore_pressure' ORDER BY rowid");
+    s.bind(1, run);
+    while (s.step()) r.pores.push_back({s.text(0), s.real(1), s.real(2), s.real(3), s.real(4)});
+  }
   return r;
 }
 

@@ -34,6 +34,12 @@ struct EventRow {
   bool intragranular;  // inside a grain (crushing) rather than between grains
 };
 
+// The steady pressure of one pore of a flow network (permeameter), at its centroid.
+struct PoreRow {
+  std::string stage;  // "initial" or "final"
+  double x, y, z, pressure;
+};
+
 struct RunData {
   std::int64_t id = 0;
   std::string protocol, rig, status, reason, started, code_version, build_type, protocol_file;
@@ -45,6 +51,7 @@ struct RunData {
   std::map<std::string, SeriesData> series;
   std::vector<SnapshotRow> snapshots;
   std::vector<EventRow> breaks;  // bond breaks
+  std::vector<PoreRow> pores;    // pore pressures
 
   std::string label() const { return "run " + std::to_string(id) + " " + protocol; }
   const SeriesData* find(const std::string& name) const {

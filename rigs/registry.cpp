@@ -5,6 +5,7 @@
 #include "rigs/common/specimen.hpp"
 #include "rigs/hydrostatic/hydrostatic.hpp"
 #include "rigs/oedometer/oedometer.hpp"
+#include "rigs/permeameter/permeameter.hpp"
 
 namespace rocklab::rigs {
 
@@ -23,6 +24,10 @@ const std::vector<RigEntry>& rigTable() {
        envelope::declare, envelope::validate, envelope::run},
       {"hydrostatic", "all walls servo-controlled to one stress, ramped up and optionally down",
        hydrostatic::declare, hydrostatic::validate, hydrostatic::run},
+      {"permeameter",
+       "permeameter: pore fluid driven through the sample between fixed end pressures, steady "
+       "flow every n steps, Darcy permeability under hydrostatic or biaxial / triaxial loading",
+       permeameter::declare, permeameter::validate, permeameter::run},
   };
   return table;
 }

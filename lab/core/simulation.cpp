@@ -288,6 +288,7 @@ bool Simulation<D>::computeForces(double history_dt) {
     ledger_.body_work += acc.work;
     ledger_.positive_input += std::max(acc.work, 0.0);
   }
+  if (!applied_.empty()) applyForces(history_dt);
   const auto t1 = std::chrono::steady_clock::now();
   ContactPass<D> pass{particles_,
                       contacts_,
@@ -302,13 +303,30 @@ bool Simulation<D>::computeForces(double history_dt) {
   ledger_.viscous += pass.viscous;
   const auto t2 = std::chrono::steady_clock::now();
   if (bonds_.size() > 0) computeBondForces(history_dt);
-  if (gravity) {
+  if (gravity || !applied_.empty()) {
     stage_seconds_[kBodyForces] += std::chrono::duration<double>(t1 - t0).count();
     ++stage_calls_[kBodyForces];
   }
   stage_seconds_[kContacts] += std::chrono::duration<double>(t2 - t1).count();
   ++stage_calls_[kContacts];
   return pass.overlap_exceeded;
+}
+
+template <int D>
+void Simulation<D>::applyForces(double dt) {
+  auto& P = particles_;
+  struct Acc {
+    double work = 0.0;
+    void merge(const Acc& o) { work += o.work; }
+  };
+  const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
+    const std::uint32_t slot = P.slot_of[i];
+    if (slot >= applied_.size() || P.inv_mass[i] == 0.0) return;
+    P.force[i] += applied_[slot];  // a pebble's share reaches its clump with its force
+    a.work += applied_[slot].dot(P.vel[i]) * dt;  // exact over the drift x += v dt
+  });
+  ledger_.body_work += acc.work;
+  ledger_.positive_input += std::max(acc.work, 0.0);
 }
 
 template <int D>

@@ -60,7 +60,7 @@ struct SimulationConfig {
 struct EnergyLedger {
   double initial = 0.0;        // kinetic + strain energy when the ledger started
   double boundary_work = 0.0;  // work of walls and driven (fixed) particles on the others
-  double body_work = 0.0;      // work of gravity
+  double body_work = 0.0;      // work of gravity and applied (fluid) forces
   double friction = 0.0;       // dissipated by Coulomb sliding
   double viscous = 0.0;        // dissipated by contact dashpots
   double local_damping = 0.0;  // dissipated by local (non-viscous) damping
@@ -193,6 +193,13 @@ class Simulation {
   void releaseClump(std::uint32_t clump);
   std::vector<ClumpBreak<D>> takeClumpBreaks() { return std::exchange(clump_breaks_, {}); }
 
+  // --- applied loads ---
+  // Forces on particles besides contacts, bonds and gravity (the pore fluid's), indexed by
+  // particle slot. They stay until replaced; an empty vector removes them. Their work is
+  // booked with the body forces' (ledger.body_work).
+  void setAppliedForces(std::vector<V> by_slot) { applied_ = std::move(by_slot); }
+  const std::vector<V>& appliedForces() const { return applied_; }
+
   // --- running ---
   // Validates the settings, builds the contact model and the neighbour list, evaluates the
   // forces and sets the time step; step() does it on its first call.
@@ -239,6 +246,7 @@ class Simulation {
   // step); returns whether an overlap exceeded the guard's limit.
   bool computeForces(double history_dt);
   void computeBondForces(double dt);
+  void applyForces(double dt);
   void integrateClumpsFirstHalf(double& max_speed);
   void integrateClumpsSecondHalf(double& kinetic, double& damping, double& body_work);
   void placePebbles(std::uint32_t c, bool positions);
@@ -285,6 +293,7 @@ class Simulation {
   std::vector<std::uint64_t> broken_counts_;  // 2 per kind: tensile, shear
   ClumpStore<D> clumps_;
   std::vector<ClumpBreak<D>> clump_breaks_;
+  std::vector<V> applied_;  // by slot; empty in scenes without applied forces
 
   double time_ = 0.0;
   double dt_ = 0.0;

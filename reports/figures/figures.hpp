@@ -26,5 +26,6 @@ std::vector<Figure> oedometerFigures(const std::vector<const RunData*>& runs, co
 std::vector<Figure> hydrostaticFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> biaxialFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> envelopeFigures(const std::vector<const RunData*>& runs, const Paper& paper);
+std::vector<Figure> permeameterFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 
 }  // namespace rocklab::reports

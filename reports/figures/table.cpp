@@ -4,10 +4,9 @@ namespace rocklab::reports {
 
 const std::vector<FigureEntry>& figureTable() {
   static const std::vector<FigureEntry> table = {
-      {"oedometer", oedometerFigures},
-      {"hydrostatic", hydrostaticFigures},
-      {"biaxial", biaxialFigures},
-      {"envelope", envelopeFigures},
+      {"oedometer", oedometerFigures},     {"hydrostatic", hydrostaticFigures},
+      {"biaxial", biaxialFigures},         {"envelope", envelopeFigures},
+      {"permeameter", permeameterFigures},
   };
   return table;
 }

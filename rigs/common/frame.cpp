@@ -146,6 +146,7 @@ void LoadingFrame<D>::apply() {
 template <int D>
 void LoadingFrame<D>::step() {
   apply();
+  if (effect_ && sim_->steps() % effect_interval_ == 0) effect_();
   sim_->step();
 }
 

@@ -6,6 +6,7 @@
 // wall velocities and servo targets and reads wall forces: a rig never touches particles.
 
 #include <array>
+#include <functional>
 
 #include "lab/core/simulation.hpp"
 
@@ -26,16 +27,28 @@ class LoadingFrame {
   // above. `wall_material` is an index of the simulation's material table.
   LoadingFrame(Simulation<D>& sim, const Vec<D>& lo, const Vec<D>& hi, std::uint16_t wall_material);
   // Re-attaches to a copy of the simulation this frame drives (its walls at the same
-  // indices), keeping the frame's settings.
-  void attach(Simulation<D>& sim) { sim_ = &sim; }
+  // indices), keeping the frame's settings but not its coupled effect (which acts on the
+  // original).
+  void attach(Simulation<D>& sim) {
+    sim_ = &sim;
+    effect_ = nullptr;
+  }
 
   void set(int axis, const Axis& a);
   const Axis& axis(int a) const { return axes_[a]; }
   // Servo gain (relaxation factor, 0..1] and speed cap (m/s) for stress-controlled axes.
   void setServo(double alpha, double max_speed);
 
-  // Keeps areas and strain-rate velocities current, then advances one step.
+  // Keeps areas and strain-rate velocities current, runs the coupled effect when due, then
+  // advances one step.
   void step();
+  // An effect that acts before every step whose number is a multiple of `interval`: a
+  // coupled pore fluid solved to steady state and applied to the particles (Li & Holt
+  // section 3.5.2: every n particle steps). An empty function removes it.
+  void couple(std::function<void()> effect, std::uint64_t interval) {
+    effect_ = std::move(effect);
+    effect_interval_ = std::max<std::uint64_t>(interval, 1);
+  }
 
   Simulation<D>& sim() { return *sim_; }
   const Simulation<D>& sim() const { return *sim_; }
@@ -61,6 +74,8 @@ class LoadingFrame {
   double solid_volume_ = 0.0;
   double servo_alpha_ = 0.5;
   double servo_max_speed_ = 0.0;
+  std::function<void()> effect_;
+  std::uint64_t effect_interval_ = 1;
 };
 
 }  // namespace rocklab::rigs

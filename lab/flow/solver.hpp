@@ -1,0 +1,74 @@
+#pragma once
+// Steady flow through the pore clusters with the inlet and outlet pressures imposed and no
+// flow through the sides (Li & Holt section 3.4, 3.5.2). Two solvers:
+// - explicit (the paper's): each step moves C dp dt through every pipe (equation 4) and
+//   raises each pore's pressure by K_f dV / v (equation 5), at a step no larger than the
+//   critical one, min over pores of v / (K_f sum C) (equation 6 with the fluid modulus it
+//   needs), with real or virtual (equation 7) pore volumes, until the pores balance;
+// - implicit: the balance of every free pore, sum C (p_j - p_i) = 0, solved at once as a
+//   sparse symmetric positive definite system (Eigen: Cholesky LDL^T, or conjugate
+//   gradients with an incomplete Cholesky preconditioner).
+// A cluster no conducting path links to an imposed pressure keeps the pressure it had.
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "lab/flow/network.hpp"
+
+namespace rocklab::flow {
+
+// An explicit step above the critical one: the scheme would diverge.
+class FlowStepTooLarge : public std::invalid_argument {
+ public:
+  FlowStepTooLarge(double dt, double critical);
+  double critical() const { return critical_; }
+
+ private:
+  double critical_;
+};
+
+struct Pressures {
+  double inlet = 1.0, outlet = 0.0;  // Pa
+};
+
+struct SteadyFlow {
+  std::vector<double> pressure;  // Pa, per cluster
+  double inflow = 0.0;           // m^3/s into the sample through the inlet clusters
+  double outflow = 0.0;          // m^3/s out through the outlet clusters
+  std::size_t iterations = 0;    // explicit steps, or conjugate-gradient iterations
+  double residual = 0.0;         // largest pore imbalance over its sum C times the drop
+  bool converged = false;
+  double seconds = 0.0;      // wall time of the solve
+  std::size_t isolated = 0;  // clusters with no conducting path to a boundary
+  double dt = 0.0;           // s, the explicit step used (0 for implicit)
+};
+
+// The critical explicit step (s) over the free clusters: min v / (K_f sum C).
+double criticalFlowStep(const Clusters& c, double fluid_modulus);
+
+enum class ImplicitMethod { Cholesky, ConjugateGradient };
+
+struct ImplicitSettings {
+  ImplicitMethod method = ImplicitMethod::Cholesky;
+  double tolerance = 1e-12;  // relative residual for conjugate gradients
+};
+
+SteadyFlow solveImplicit(const Clusters& c, const Pressures& bc, const ImplicitSettings& s,
+                         const std::vector<double>& previous);
+
+struct ExplicitSettings {
+  double fluid_modulus = 2.2e9;  // Pa, K_f (water)
+  double dt = 0.0;               // s; 0: the critical step
+  bool virtual_volume = false;   // equation 7: v = K_f dt sum C instead of the real volume
+  double tolerance = 1e-9;       // stop when every pore's imbalance is below this
+  std::size_t max_steps = 2000000;
+};
+
+// Starts from `previous` (per cluster; empty: the mean of the two boundary pressures).
+// Throws FlowStepTooLarge for a step above the critical one with real volumes.
+SteadyFlow solveExplicit(const Clusters& c, const Pressures& bc, const ExplicitSettings& s,
+                         const std::vector<double>& previous);
+
+}  // namespace rocklab::flow

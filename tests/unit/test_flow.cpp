@@ -1,0 +1,317 @@
+// The pore network: geometry against hand computation, the solvers against each other and
+// against Darcy's linear pressure, the explicit scheme's critical step, merging, and the
+// inputs no network can be built from.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "lab/core/random.hpp"
+#include "lab/flow/geometry.hpp"
+#include "lab/flow/network.hpp"
+#include "lab/flow/solver.hpp"
+#include "lab/flow/triangulation.hpp"
+
+namespace rocklab::flow {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Hagen-Poiseuille conductance of a throat of fluid area S and mean radius r (alpha 1).
+double handConductance(double S, double r, double mu) {
+  const double re = std::sqrt(S / kPi);
+  return kPi * std::pow(re, 4) / (8.0 * mu * r);
+}
+
+// A homogeneous pack on a lattice whose triangulation is unique (no four co-circular or
+// five co-spherical centres): triangular in 2D (spacing 1), body-centred cubic in 3D (cube
+// side 1), n[d] cells per axis; centres moved by up to +-jitter, radii within +-10%.
+template <int D>
+PackView<D> latticePack(const std::array<int, D>& n, double radius, double jitter,
+                        std::uint64_t seed) {
+  Rng rng(seed);
+  PackView<D> p;
+  auto add = [&](Vec<D> x) {
+    for (int d = 0; d < D; ++d) x[d] += rng.uniform(-jitter, jitter);
+    p.centre.push_back(x);
+    p.radius.push_back(radius * rng.uniform(0.9, 1.1));
+  };
+  if constexpr (D == 2) {
+    const double row = std::sqrt(3.0) / 2.0;
+    for (int j = 0; j < n[1]; ++j) {
+      for (int i = 0; i < n[0]; ++i) add({i + 0.5 * (j % 2), j * row});
+    }
+  } else {
+    for (int k = 0; k < n[2]; ++k) {
+      for (int j = 0; j < n[1]; ++j) {
+        for (int i = 0; i < n[0]; ++i) {
+          add({double(i), double(j), double(k)});
+          if (i + 1 < n[0] && j + 1 < n[1] && k + 1 < n[2]) add({i + 0.5, j + 0.5, k + 0.5});
+        }
+      }
+    }
+  }
+  return p;
+}
+
+// The network of a pack, its hull trimmed as the coupling does.
+template <int D>
+Network<D> networkOf(const PackView<D>& p) {
+  auto t = triangulate<D>(p.centre, p.radius);
+  trimHull<D>(t, p.centre, p.radius, 2.0);
+  Network<D> net(std::move(t), 1.0);
+  net.measure(p, {});
+  return net;
+}
+
+template <int D>
+std::vector<PoreBoundary> endLayers(const Network<D>& net, double lo, double hi) {
+  std::vector<PoreBoundary> b(net.pores(), PoreBoundary::Free);
+  for (std::size_t c = 0; c < net.pores(); ++c) {
+    const double h = net.centroid()[c][D - 1];
+    if (h >= hi) b[c] = PoreBoundary::Inlet;
+    if (h <= lo) b[c] = PoreBoundary::Outlet;
+  }
+  return b;
+}
+
+TEST(FlowGeometry, SolidAngleOfAnOctantIsHalfPi) {
+  EXPECT_NEAR(solidAngle({1, 0, 0}, {0, 1, 0}, {0, 0, 1}), kPi / 2, 1e-14);
+  // A face seen from its far side still subtends the same angle (orientation-free).
+  EXPECT_NEAR(solidAngle({1, 0, 0}, {0, 0, 1}, {0, 1, 0}), kPi / 2, 1e-14);
+}
+
+TEST(FlowGeometry, PoreVolumeIsTheCellMinusTheSectors) {
+  // The corner tetrahedron with a sphere of radius 0.3 at the right-angled corner only:
+  // 1/6 minus an eighth of the sphere.
+  Triangulation<3> t;
+  t.cells = {{0, 1, 2, 3}};
+  t.neighbours = {{kHull, kHull, kHull, kHull}};
+  PackView<3> p;
+  p.centre = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  p.radius = {0.3, 0.0, 0.0, 0.0};
+  Network<3> net(t, 1.0);
+  net.measure(p, {});
+  EXPECT_NEAR(net.volume()[0], 1.0 / 6.0 - kPi * 0.027 / 6.0, 1e-14);
+  // 2D: the right triangle minus a quarter disk, times the slice.
+  Triangulation<2> t2;
+  t2.cells = {{0, 1, 2}};
+  t2.neighbours = {{kHull, kHull, kHull}};
+  PackView<2> p2;
+  p2.centre = {{0, 0}, {1, 0}, {0, 1}};
+  p2.radius = {0.3, 0.0, 0.0};
+  Network<2> net2(t2, 0.5);
+  net2.measure(p2, {});
+  EXPECT_NEAR(net2.volume()[0], 0.5 * (0.5 - kPi * 0.09 / 4.0), 1e-14);
+}
+
+// Two cells sharing one pipe whose throat is an equilateral triangle of side 1 between
+// particles of radius r: its area less three 60-degree fans, Hagen-Poiseuille's conductance.
+template <int D>
+void expectOneEquilateralThroat(Network<D>& net, const PackView<D>& p, double r, double mu) {
+  ASSERT_EQ(net.pores(), 2u);
+  ASSERT_EQ(net.pipes(), 1u);
+  net.measure(p, {1.0, mu});
+  const double S = std::sqrt(3.0) / 4.0 - kPi * r * r / 2.0;
+  EXPECT_NEAR(net.throat()[0], S, 1e-12);
+  EXPECT_NEAR(net.conductance()[0] / handConductance(S, r, mu), 1.0, 1e-12);
+}
+
+// Two tetrahedra on an equilateral triangle of side 1 (apexes far enough that the shared
+// face is Delaunay): one pipe, whose throat is the triangle minus three 60-degree fans.
+TEST(FlowGeometry, ThreeDimensionalPipeConductanceByHand) {
+  const double r = 0.3, mu = 1e-3, h = std::sqrt(3.0) / 6.0;
+  PackView<3> p;
+  p.centre = {{0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}, {0.5, h, 1}, {0.5, h, -1}};
+  p.radius.assign(5, r);
+  Network<3> net(triangulate<3>(p.centre, p.radius), 1.0);
+  expectOneEquilateralThroat(net, p, r, mu);
+  // Equation 3's factor scales it.
+  const double S = std::sqrt(3.0) / 4.0 - kPi * r * r / 2.0;
+  net.measure(p, {0.82, mu});
+  EXPECT_NEAR(net.conductance()[0] / handConductance(S, r, mu), 0.82, 1e-12);
+}
+
+// 2D: two triangles on a shared edge of length 1 between disks of radius r. With the
+// virtual third particle of the pair's radius at the pair's gap (Figure 8), the throat
+// triangle is equilateral of side 1, as in the 3D case.
+TEST(FlowGeometry, TwoDimensionalPipeThroughTheVirtualThirdParticle) {
+  const double r = 0.35, mu = 2e-3;
+  PackView<2> p;
+  p.centre = {{0, 0}, {1, 0}, {0.5, 0.9}, {0.5, -0.9}};
+  p.radius.assign(4, r);
+  Network<2> net(triangulate<2>(p.centre, p.radius), 2 * r);
+  expectOneEquilateralThroat(net, p, r, mu);
+}
+
+TEST(FlowGeometry, CementNarrowsTheThroatAndBreakageOpensIt) {
+  const double r = 0.3, R = 0.15;
+  PackView<3> p;
+  const double h = std::sqrt(3.0) / 6.0;
+  p.centre = {{0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}, {0.5, h, 1}, {0.5, h, -1}};
+  p.radius.assign(5, r);
+  Network<3> net = networkOf<3>(p);
+  const double open = net.throat()[0];
+  p.bond = {{0, 1}};
+  p.bond_radius = {R};
+  net.measure(p, {});
+  // A strip R wide over the gap of 0.4 and the neck, on the throat's side of the bond.
+  const double cement = R * 0.4 + R * R * R * (2.0 / r) / 6.0;
+  EXPECT_NEAR(open - net.throat()[0], cement, 1e-12);
+  p.bond.clear();
+  p.bond_radius.clear();
+  net.measure(p, {});
+  EXPECT_DOUBLE_EQ(net.throat()[0], open);
+}
+
+TEST(FlowNetwork, UniformPressurePushesNoParticle) {
+  const auto p = latticePack<3>({4, 4, 4}, 0.36, 0.05, 3);
+  const Network<3> net = networkOf<3>(p);
+  const auto f = net.particleForces(std::vector<double>(net.pores(), 5e5), p, 1.0);
+  for (const auto& fi : f) EXPECT_LT(fi.norm(), 1e-9);
+}
+
+// The steady pressure of a homogeneous pack: both implicit methods and the explicit scheme
+// agree to 1e-6 of the drop, inflow equals outflow, and the pressure falls linearly along
+// the flow (Darcy; the paper's Figure 11).
+template <int D>
+void steadyFlowIsLinearAndTheSolversAgree(const std::array<int, D>& n) {
+  const auto p = latticePack<D>(n, D == 2 ? 0.4 : 0.36, 0.05, 11);
+  const Network<D> net = networkOf<D>(p);
+  double top = 0.0;
+  for (const auto& x : p.centre) top = std::max(top, x[D - 1]);
+  const double lo = 1.0, hi = top - 1.0;  // layers one spacing thick at both ends
+  const auto boundary = endLayers<D>(net, lo, hi);
+  const Clusters c = mergePores<D>(net, boundary, {});
+  const Pressures bc{2.0e4, 1.0e4};
+  const auto chol = solveImplicit(c, bc, {ImplicitMethod::Cholesky, 0}, {});
+  const auto cg = solveImplicit(c, bc, {ImplicitMethod::ConjugateGradient, 1e-12}, {});
+  ExplicitSettings ex;
+  ex.virtual_volume = true;
+  ex.tolerance = 1e-11;
+  const auto explicit_flow = solveExplicit(c, bc, ex, {});
+  ASSERT_TRUE(chol.converged && cg.converged && explicit_flow.converged);
+  const double drop = bc.inlet - bc.outlet;
+  for (std::size_t i = 0; i < c.count; ++i) {
+    EXPECT_NEAR(cg.pressure[i], chol.pressure[i], 1e-6 * drop);
+    EXPECT_NEAR(explicit_flow.pressure[i], chol.pressure[i], 1e-6 * drop);
+  }
+  EXPECT_GT(chol.inflow, 0.0);
+  EXPECT_NEAR(chol.outflow / chol.inflow, 1.0, 1e-9);
+  EXPECT_NEAR(explicit_flow.inflow / chol.inflow, 1.0, 1e-6);
+  // Darcy: the free pores' pressure is a straight line of the height. Fit it, and average
+  // each pore's departure from it over slabs one spacing thick.
+  std::vector<double> h, pr;
+  for (std::size_t k = 0; k < net.pores(); ++k) {
+    if (boundary[k] != PoreBoundary::Free) continue;
+    h.push_back(net.centroid()[k][D - 1]);
+    pr.push_back(chol.pressure[c.of_pore[k]]);
+  }
+  const double n_free = static_cast<double>(h.size());
+  double mh = 0, mp = 0, shh = 0, shp = 0;
+  for (std::size_t k = 0; k < h.size(); ++k) mh += h[k] / n_free, mp += pr[k] / n_free;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    shh += (h[k] - mh) * (h[k] - mh), shp += (h[k] - mh) * (pr[k] - mp);
+  }
+  const double slope = shp / shh;
+  // The layers' pressures are imposed at their inner edges give or take half a spacing.
+  EXPECT_NEAR(slope * (hi - lo) / drop, 1.0, 0.1);
+  const int slabs = static_cast<int>(std::floor(hi - lo));
+  std::vector<double> off(slabs, 0.0), count(slabs, 0.0);
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    const int s = static_cast<int>((h[k] - lo) / (hi - lo) * slabs);
+    if (s < 0 || s >= slabs) continue;
+    off[s] += pr[k] - (mp + slope * (h[k] - mh));
+    count[s] += 1.0;
+  }
+  for (int s = 0; s < slabs; ++s) {
+    ASSERT_GT(count[s], 0.0);
+    EXPECT_LT(std::abs(off[s] / count[s]), 0.02 * drop) << "slab " << s;
+  }
+}
+
+TEST(FlowSolvers, SteadyPressureIsLinearAndSolversAgree3D) {
+  steadyFlowIsLinearAndTheSolversAgree<3>({6, 6, 12});
+}
+
+TEST(FlowSolvers, SteadyPressureIsLinearAndSolversAgree2D) {
+  steadyFlowIsLinearAndTheSolversAgree<2>({16, 28});
+}
+
+TEST(FlowSolvers, ExplicitSchemeIsStableAtItsCriticalStepAndRefusesALargerOne) {
+  const auto p = latticePack<3>({4, 4, 7}, 0.36, 0.05, 5);
+  const Network<3> net = networkOf<3>(p);
+  // Flat cells would make the step vanish: small pores join their best neighbour.
+  const Clusters c = mergePores<3>(net, endLayers<3>(net, 1.0, 4.0), {0.0, 0.05});
+  const Pressures bc{1.0e4, 0.0};
+  ExplicitSettings ex;
+  ex.fluid_modulus = 2.2e9;
+  ex.tolerance = 1e-8;
+  const double critical = criticalFlowStep(c, ex.fluid_modulus);
+  ASSERT_GT(critical, 0.0);
+  ex.dt = critical;
+  const auto at_critical = solveExplicit(c, bc, ex, {});
+  EXPECT_TRUE(at_critical.converged);
+  const auto exact = solveImplicit(c, bc, {}, {});
+  for (std::size_t i = 0; i < c.count; ++i) {
+    EXPECT_NEAR(at_critical.pressure[i], exact.pressure[i], 1e-6 * bc.inlet);
+  }
+  ex.dt = 1.01 * critical;
+  try {
+    solveExplicit(c, bc, ex, {});
+    FAIL() << "a step above the critical one was accepted";
+  } catch (const FlowStepTooLarge& e) {
+    EXPECT_DOUBLE_EQ(e.critical(), critical);
+    EXPECT_NE(std::string(e.what()).find("critical step"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FlowNetwork, MergingKeepsVolumeAndNeverJoinsInletToOutlet) {
+  const auto p = latticePack<3>({5, 5, 8}, 0.36, 0.05, 9);
+  const Network<3> net = networkOf<3>(p);
+  const auto boundary = endLayers<3>(net, 1.0, 5.0);
+  const Clusters all = mergePores<3>(net, boundary, {});
+  EXPECT_EQ(all.count, net.pores());
+  EXPECT_EQ(all.edge_a.size(), net.pipes());
+  const Clusters merged = mergePores<3>(net, boundary, {5.0, 0.05});
+  EXPECT_LT(merged.count, all.count);
+  EXPECT_LT(merged.edge_a.size(), all.edge_a.size());
+  double v_all = 0.0, v_merged = 0.0;
+  for (double v : all.volume) v_all += v;
+  for (double v : merged.volume) v_merged += v;
+  EXPECT_NEAR(v_merged, v_all, 1e-12 * v_all);
+  for (std::size_t k = 0; k < net.pores(); ++k) {
+    const auto cb = merged.boundary[merged.of_pore[k]];
+    if (boundary[k] != PoreBoundary::Free) {
+      EXPECT_EQ(cb, boundary[k]);
+    }
+  }
+  // Merging is an approximation (section 3.2): the flow stays within a few percent.
+  const Pressures bc{1.0, 0.0};
+  const double q_all = solveImplicit(all, bc, {}, {}).inflow;
+  const double q_merged = solveImplicit(merged, bc, {}, {}).inflow;
+  EXPECT_NEAR(q_merged / q_all, 1.0, 0.25);
+  // The small-pore rule lifts the critical step.
+  EXPECT_GT(criticalFlowStep(merged, 1.0), criticalFlowStep(all, 1.0));
+}
+
+TEST(FlowNetwork, DegenerateInputIsRefusedWithTheReason) {
+  std::vector<Vec<3>> plane;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) plane.push_back({double(i), double(j), 0.0});
+  }
+  try {
+    triangulate<3>(plane, std::vector<double>(plane.size(), 0.4));
+    FAIL() << "co-planar centres were accepted";
+  } catch (const DegenerateNetwork& e) {
+    EXPECT_NE(std::string(e.what()).find("one plane"), std::string::npos) << e.what();
+  }
+  std::vector<Vec<2>> line{{0, 0}, {1, 1}, {2, 2}, {3, 3}};
+  EXPECT_THROW(triangulate<2>(line, std::vector<double>(4, 0.4)), DegenerateNetwork);
+  std::vector<Vec<3>> one{{0, 0, 0}};
+  EXPECT_THROW(triangulate<3>(one, {0.5}), DegenerateNetwork);
+}
+
+}  // namespace
+}  // namespace rocklab::flow
