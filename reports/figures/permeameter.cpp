@@ -1,6 +1,6 @@
 // The permeameter's figures (Li & Holt section 3.5): the steady pore-pressure field before
 // loading (Figure 11), k/k0 against porosity beside Kozeny-Carman (Figures 12 and 13), k/k0
-// against stress, along and normal to the loading when both were measured (Figure 14), and
+// under loading, along and normal to it when both were measured (Figure 14), and
 // what each flow solver cost on the same network.
 
 #include <algorithm>
@@ -97,42 +97,48 @@ Figure permeabilityPorosity(const std::vector<const RunData*>& runs) {
   return f;
 }
 
-Figure permeabilityStress(const std::vector<const RunData*>& runs) {
+// k/k0 of every measured direction, and Kozeny-Carman's, against series `x` of a run.
+void permeabilityCurves(const RunData& r, const std::string& x, Panel& p) {
+  for (const char* dir : {"along", "normal"}) {
+    Series s{r.label() + " flow " + dir, {}, {}, false};
+    pair(r, x, std::string("k_over_k0_") + dir, s.x, s.y);
+    if (!s.x.empty()) p.series.push_back(s);
+  }
+  if (!r.find("k_over_k0_along") && !r.find("k_over_k0_normal")) {
+    Series s{r.label(), {}, {}, false};
+    pair(r, x, "k_over_k0", s.x, s.y);
+    if (!s.x.empty()) p.series.push_back(s);
+  }
+  Series kc{r.label() + " KC", {}, {}, false};
+  pair(r, x, "kozeny_carman_over_k0", kc.x, kc.y);
+  if (!kc.x.empty()) p.series.push_back(kc);
+}
+
+Figure permeabilityLoading(const std::vector<const RunData*>& runs) {
   Figure f;
-  f.id = "permeability-stress";
-  f.title = "Permeability against stress";
+  f.id = "permeability-loading";
+  f.title = "Permeability under loading";
   f.caption =
-      "k/k0 against the mean stress (hydrostatic loading) or the axial stress (biaxial "
-      "loading, with the flow along and normal to the loading when both were measured), "
-      "beside Kozeny-Carman (top); the stress against axial strain of the biaxial tests "
-      "(bottom) locates failure (cf. Figure 14).";
-  Panel k{"stress (MPa)", "k / k0 (-)", {}};
+      "k/k0 beside Kozeny-Carman (KC): against the mean stress under hydrostatic loading; "
+      "against the axial strain under biaxial loading, with the flow along and normal to the "
+      "loading when both were measured, above the test's stress-strain curve, which locates "
+      "failure (cf. Figure 14).";
+  Panel stress{"mean stress (MPa)", "k / k0 (-)", {}};
+  Panel strain{"axial strain (-)", "k / k0 (-)", {}};
   Panel curve{"axial strain (-)", "deviatoric stress (MPa)", {}};
   for (const RunData* r : runs) {
-    const std::string stress =
-        biaxialLoading(*r) ? "flow.axial_stress_MPa" : "flow.mean_stress_MPa";
-    for (const char* dir : {"along", "normal"}) {
-      Series s{r->label() + " flow " + dir, {}, {}, false};
-      pair(*r, stress, std::string("k_over_k0_") + dir, s.x, s.y);
-      if (!s.x.empty()) k.series.push_back(s);
+    if (!biaxialLoading(*r)) {
+      permeabilityCurves(*r, "flow.mean_stress_MPa", stress);
+      continue;
     }
-    if (!r->find("k_over_k0_along") && !r->find("k_over_k0_normal")) {
-      Series s{r->label(), {}, {}, false};
-      pair(*r, stress, "k_over_k0", s.x, s.y);
-      if (!s.x.empty()) k.series.push_back(s);
-    }
-    Series kc{r->label() + " KC", {}, {}, false};
-    pair(*r, stress, "kozeny_carman_over_k0", kc.x, kc.y);
-    if (!kc.x.empty()) k.series.push_back(kc);
-    if (biaxialLoading(*r)) {
-      Series q{r->label(), {}, {}, false};
-      pair(*r, "axial_strain", "deviatoric_stress_MPa", q.x, q.y);
-      if (!q.x.empty()) curve.series.push_back(q);
-    }
+    permeabilityCurves(*r, "flow.axial_strain", strain);
+    Series q{r->label(), {}, {}, false};
+    pair(*r, "axial_strain", "deviatoric_stress_MPa", q.x, q.y);
+    if (!q.x.empty()) curve.series.push_back(q);
   }
-  if (k.series.empty()) return {};
-  f.panels = {k};
-  if (!curve.series.empty()) f.panels.push_back(curve);
+  for (Panel* p : {&stress, &strain, &curve}) {
+    if (!p->series.empty()) f.panels.push_back(*p);
+  }
   return f;
 }
 
@@ -176,7 +182,7 @@ std::vector<Figure> permeameterFigures(const std::vector<const RunData*>& runs, 
   for (const RunData* r : runs) {
     if (!r->pores.empty()) out.push_back(pressureField(*r));
   }
-  for (Figure f : {permeabilityPorosity(runs), permeabilityStress(runs), solverCost(runs)}) {
+  for (Figure f : {permeabilityPorosity(runs), permeabilityLoading(runs), solverCost(runs)}) {
     if (!f.panels.empty()) out.push_back(std::move(f));
   }
   return out;
