@@ -120,11 +120,13 @@ Figure permeabilityLoading(const std::vector<const RunData*>& runs) {
   f.title = "Permeability under loading";
   f.caption =
       "k/k0 beside Kozeny-Carman (KC): against the mean stress under hydrostatic loading; "
-      "against the axial strain under biaxial loading, with the flow along and normal to the "
-      "loading when both were measured, above the test's stress-strain curve, which locates "
-      "failure (cf. Figure 14).";
+      "under biaxial loading against the axial strain and the axial stress (which falls back "
+      "after the peak), with the flow along and normal to the loading when both were "
+      "measured, above the test's stress-strain curve, which locates failure (cf. Figure "
+      "14).";
   Panel stress{"mean stress (MPa)", "k / k0 (-)", {}};
   Panel strain{"axial strain (-)", "k / k0 (-)", {}};
+  Panel axial{"axial stress (MPa)", "k / k0 (-)", {}};
   Panel curve{"axial strain (-)", "deviatoric stress (MPa)", {}};
   for (const RunData* r : runs) {
     if (!biaxialLoading(*r)) {
@@ -132,11 +134,12 @@ Figure permeabilityLoading(const std::vector<const RunData*>& runs) {
       continue;
     }
     permeabilityCurves(*r, "flow.axial_strain", strain);
+    permeabilityCurves(*r, "flow.axial_stress_MPa", axial);
     Series q{r->label(), {}, {}, false};
     pair(*r, "axial_strain", "deviatoric_stress_MPa", q.x, q.y);
     if (!q.x.empty()) curve.series.push_back(q);
   }
-  for (Panel* p : {&stress, &strain, &curve}) {
+  for (Panel* p : {&stress, &strain, &axial, &curve}) {
     if (!p->series.empty()) f.panels.push_back(*p);
   }
   return f;

@@ -127,6 +127,34 @@ TEST_F(Report, TwoRunsOverlaidWithSnapshotsAndParaViewExport) {
   }
 }
 
+// The permeameter's figures (Li & Holt Figures 11-14): the pressure field, k/k0 against
+// porosity and under loading beside Kozeny-Carman, and the solvers' cost, each drawn and
+// with its data behind it.
+TEST_F(Report, PermeameterFiguresAreDrawnWithTheirData) {
+  std::string out;
+  ASSERT_EQ(rocklab::testing::runRocklab(std::string("run ") + ROCKLAB_SOURCE_DIR +
+                                             "/protocols/permeameter-plane-strain-2d-quick.toml"
+                                             " --quiet --threads 1 --lab " +
+                                             lab_,
+                                         &out),
+            0)
+      << out;
+  const std::string rep = (dir_ / "report").string();
+  ASSERT_EQ(rocklab::testing::runRocklab("report 1 --lab " + lab_ + " --out " + rep, &out), 0)
+      << out;
+  for (const char* id : {"pressure-field-run1", "permeability-porosity", "permeability-loading",
+                         "flow-solver-cost"}) {
+    const std::string png = rep + "/" + id + ".png";
+    ASSERT_TRUE(fs::exists(png)) << png;
+    EXPECT_GT(nonWhite(png), 0.02) << png;
+    std::ifstream csv(rep + "/" + id + ".csv");
+    std::string line;
+    int rows = 0;
+    while (std::getline(csv, line)) ++rows;
+    EXPECT_GT(rows, 4) << id;
+  }
+}
+
 TEST_F(Report, MissingRunsAndLabsAreRefused) {
   std::string out;
   EXPECT_NE(rocklab::testing::runRocklab(
