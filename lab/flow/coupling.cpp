@@ -119,7 +119,8 @@ FlowReading FlowCoupling<D>::measure(const Simulation<D>& sim) {
     std::sort(slots_.begin(), slots_.end());
     network_.reset();
   }
-  PackView<D> now = pack(sim);
+  pack_ = pack(sim);
+  const PackView<D>& now = pack_;
   double radii = 0.0;
   for (double r : now.radius) radii += r;
   mean_radius_ = radii / static_cast<double>(std::max<std::size_t>(now.radius.size(), 1));
@@ -190,7 +191,7 @@ FlowReading FlowCoupling<D>::update(Simulation<D>& sim) {
   FlowReading r = measure(sim);
   if (settings_.apply_forces) {
     const auto& P = sim.particles();
-    const auto force = network_->particleForces(pore_pressure_, pack(sim), P.thickness);
+    const auto force = network_->particleForces(pore_pressure_, pack_, P.thickness);
     std::vector<V> by_slot(P.slotCapacity(), V::Zero());
     for (std::size_t k = 0; k < slots_.size(); ++k) by_slot[slots_[k]] = force[k];
     sim.setAppliedForces(std::move(by_slot));

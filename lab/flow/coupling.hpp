@@ -101,6 +101,7 @@ class FlowCoupling {
   std::optional<Network<D>> network_;
   std::vector<std::uint32_t> slots_;  // pack index -> particle slot
   std::vector<V> built_at_;           // centres at the last triangulation
+  PackView<D> pack_;                  // the particles as last measured
   std::vector<PoreBoundary> boundary_;
   std::vector<double> pore_pressure_;
   Clusters clusters_;

@@ -68,13 +68,6 @@ void validate(const Settings& s) {
 
 namespace {
 
-std::string fmt(double v) {
-  std::ostringstream o;
-  o.precision(3);
-  o << v;
-  return o.str();
-}
-
 template <int D>
 double lateralStress(const LoadingFrame<D>& f) {
   double sum = 0.0;

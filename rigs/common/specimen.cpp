@@ -191,6 +191,13 @@ void validateCommon(const Settings& s) {
   }
 }
 
+std::string fmt(double v, int precision) {
+  std::ostringstream o;
+  o.precision(precision);
+  o << v;
+  return o.str();
+}
+
 namespace {
 
 SizeDistribution sizes(const Settings& s) {
@@ -223,13 +230,6 @@ MaterialTable materials(const Settings& s, double friction) {
   wall.name = "wall";
   t.add(wall);
   return t;
-}
-
-std::string fmt(double v, int precision = 3) {
-  std::ostringstream o;
-  o.precision(precision);
-  o << v;
-  return o.str();
 }
 
 // Runs the frame until the stresses hold and the sample is in equilibrium.

@@ -22,6 +22,9 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
 // Checks across keys of the shared sections (throws protocol::ProtocolError).
 void validateCommon(const Settings& s);
 
+// A number for a message: `precision` significant digits.
+std::string fmt(double v, int precision = 3);
+
 // Runs `body(std::integral_constant<int, D>{})` for the protocol's dimension: a rig's
 // entry point picks its 2D or 3D instantiation in one line.
 template <class Body>

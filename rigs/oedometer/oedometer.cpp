@@ -76,13 +76,6 @@ struct Cycle {
   double at_strain = 0, peak_stress = 0, peak_strain = 0, low_stress = 0, low_strain = 0;
 };
 
-std::string fmt(double v) {
-  std::ostringstream o;
-  o.precision(3);
-  o << v;
-  return o.str();
-}
-
 // Fits over the loading points with strain in [lo, hi].
 double fitWindow(const std::vector<Sample>& pts, double lo, double hi, bool stress_path) {
   std::vector<double> x, y;

@@ -106,13 +106,6 @@ namespace {
 using flow::FlowCoupling;
 using flow::FlowReading;
 
-std::string fmt(double v) {
-  std::ostringstream o;
-  o.precision(3);
-  o << v;
-  return o.str();
-}
-
 // Kozeny-Carman, equation 8: k = d^2 phi^3 / (36 gamma_T (1 - phi)^2).
 double kozenyCarman(double d, double phi, double gamma_t) {
   return d * d * phi * phi * phi / (36.0 * gamma_t * (1.0 - phi) * (1.0 - phi));
