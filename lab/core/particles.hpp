@@ -83,6 +83,9 @@ class ParticleStore {
     return {s, slot_generation_[s]};
   }
   std::size_t indexOfSlot(std::uint32_t slot) const { return slot_index_[slot]; }
+  bool occupied(std::uint32_t slot) const {
+    return slot < slot_index_.size() && slot_index_[slot] != kNoIndex;
+  }
   std::size_t slotCapacity() const { return slot_index_.size(); }
 
   double mass(std::size_t i) const { return inv_mass[i] > 0 ? 1.0 / inv_mass[i] : INFINITY; }

@@ -1384,6 +1384,43 @@ void Simulation<D>::breakOverloadedClumps() {
 }
 
 template <int D>
+void Simulation<D>::drive(const std::vector<std::uint32_t>& slots) {
+  auto& P = particles_;
+  for (std::uint32_t slot : slots) {
+    const std::size_t i = drivenIndex(slot);
+    if (P.body[i] != kNoBody) {
+      throw std::invalid_argument(
+          "particle " + std::to_string(slot) +
+          " is a clump pebble: it moves with its body and cannot be driven");
+    }
+    P.inv_mass[i] = 0.0;
+    P.inv_inertia[i] = 0.0;
+    P.spin[i] = angZero<A>();
+  }
+}
+
+template <int D>
+void Simulation<D>::setDrivenVelocity(const std::vector<std::uint32_t>& slots, const V& velocity) {
+  auto& P = particles_;
+  for (std::uint32_t slot : slots) {
+    const std::size_t i = drivenIndex(slot);
+    if (P.inv_mass[i] != 0.0) {
+      throw std::invalid_argument("particle " + std::to_string(slot) +
+                                  " is not driven: call drive() on it first");
+    }
+    P.vel[i] = velocity;
+  }
+}
+
+template <int D>
+std::size_t Simulation<D>::drivenIndex(std::uint32_t slot) const {
+  if (!particles_.occupied(slot)) {
+    throw std::invalid_argument("no particle at slot " + std::to_string(slot));
+  }
+  return particles_.indexOfSlot(slot);
+}
+
+template <int D>
 void Simulation<D>::releaseClump(std::uint32_t c) {
   auto& P = particles_;
   auto& K = clumps_;

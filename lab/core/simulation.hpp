@@ -193,6 +193,14 @@ class Simulation {
   void releaseClump(std::uint32_t clump);
   std::vector<ClumpBreak<D>> takeClumpBreaks() { return std::exchange(clump_breaks_, {}); }
 
+  // --- driven particles (a wave transmitter, DESIGN.md Waves) ---
+  // Makes the particles at these slots driven: infinite mass and inertia, no spin, moving
+  // with the velocity setDrivenVelocity gives them whatever the forces on them; their work
+  // on the others is booked as boundary work. Clump pebbles cannot be driven.
+  void drive(const std::vector<std::uint32_t>& slots);
+  // The velocity of driven particles from this step on (the rig's source signal).
+  void setDrivenVelocity(const std::vector<std::uint32_t>& slots, const V& velocity);
+
   // --- applied loads ---
   // Forces on particles besides contacts, bonds and gravity (the pore fluid's), indexed by
   // particle slot. They stay until replaced; an empty vector removes them. Their work is
@@ -250,6 +258,7 @@ class Simulation {
   void integrateClumpsFirstHalf(double& max_speed);
   void integrateClumpsSecondHalf(double& kinetic, double& damping, double& body_work);
   void placePebbles(std::uint32_t c, bool positions);
+  std::size_t drivenIndex(std::uint32_t slot) const;  // throws for a free slot
   void gatherClumpLoad(std::uint32_t c);
   void breakOverloadedClumps();
   bool hasClumps() const { return !clumps_.pos.empty(); }
