@@ -87,6 +87,7 @@ RunData loadRun(notebook::Notebook& nb, std::int64_t run) {
     s.bind(1, run);
     while (s.step()) r.pores.push_back({s.text(0), s.real(1), s.real(2), s.real(3), s.real(4)});
   }
+  r.waves = notebook::wavesOf(nb, run);
   return r;
 }
 

@@ -50,8 +50,9 @@ struct RunData {
   std::vector<std::pair<std::string, std::string>> messages;           // level, text
   std::map<std::string, SeriesData> series;
   std::vector<SnapshotRow> snapshots;
-  std::vector<EventRow> breaks;  // bond breaks
-  std::vector<PoreRow> pores;    // pore pressures
+  std::vector<EventRow> breaks;          // bond breaks
+  std::vector<PoreRow> pores;            // pore pressures
+  std::vector<notebook::WaveRow> waves;  // ultrasonic measurements with traces and picks
 
   std::string label() const { return "run " + std::to_string(id) + " " + protocol; }
   const SeriesData* find(const std::string& name) const {

@@ -6,6 +6,7 @@
 #include "rigs/hydrostatic/hydrostatic.hpp"
 #include "rigs/oedometer/oedometer.hpp"
 #include "rigs/permeameter/permeameter.hpp"
+#include "rigs/ultrasonic/ultrasonic.hpp"
 
 namespace rocklab::rigs {
 
@@ -28,6 +29,11 @@ const std::vector<RigEntry>& rigTable() {
        "permeameter: pore fluid driven through the sample between fixed end pressures, steady "
        "flow every n steps, Darcy permeability under hydrostatic or biaxial / triaxial loading",
        permeameter::declare, permeameter::validate, permeameter::run},
+      {"ultrasonic",
+       "ultrasonic bench: P and S waves (pz, px, szx, sxy) through copies of a sample at stages "
+       "of hydrostatic, uniaxial-strain or triaxial loading; FFT-picked velocities, dynamic "
+       "and static moduli",
+       ultrasonic::declare, ultrasonic::validate, ultrasonic::run},
   };
   return table;
 }

@@ -63,6 +63,30 @@ class NotebookRecorder : public rigs::Recorder {
   void snapshot(std::string_view stage, std::string_view label, const Frame& frame) override {
     w_.snapshot("frame", stage, label, frame.step, frame.time, encodeFrame(frame), "rkf");
   }
+  void wave(const rigs::WaveRecord& w) override {
+    auto known = [](bool found, double v) {
+      return found ? std::optional<double>(v) : std::nullopt;
+    };
+    notebook::WaveRow r;
+    r.step = w.step, r.time = w.time, r.stage = w.stage, r.name = w.name, r.type = w.type;
+    r.propagation_axis = w.propagation_axis, r.polarisation_axis = w.polarisation_axis;
+    r.frequency = w.frequency, r.amplitude = w.amplitude, r.dt = w.dt;
+    r.velocity_xcorr = known(w.velocity_xcorr > 0.0, w.velocity_xcorr);
+    r.velocity_first_break = known(w.velocity_first_break > 0.0, w.velocity_first_break);
+    r.source = w.source;
+    for (const auto& x : w.receivers) {
+      notebook::WaveRow::Receiver y;
+      y.distance = x.distance;
+      y.particles = static_cast<std::int64_t>(x.particles);
+      y.picked_samples = static_cast<std::int64_t>(x.picked_samples);
+      y.samples = x.samples;
+      y.xcorr_time = known(x.xcorr_found, x.xcorr_time);
+      y.xcorr_quality = known(x.xcorr_found, x.xcorr_quality);
+      y.first_break_time = known(x.first_break_found, x.first_break_time);
+      r.receivers.push_back(std::move(y));
+    }
+    w_.wave(r);
+  }
 
  private:
   notebook::RunWriter& w_;

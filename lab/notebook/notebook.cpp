@@ -159,6 +159,45 @@ CREATE TABLE snapshots (
 );
 CREATE INDEX snapshots_by_run ON snapshots (run_id, step);
 )sql",
+      // 4 -> 5: ultrasonic measurements. Traces are BLOBs of little-endian float64 samples,
+      // one every dt_s from the pulse's start (a window of thousands of steps per receiver).
+      R"sql(
+CREATE TABLE waves (
+  id INTEGER PRIMARY KEY,
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  step INTEGER NOT NULL,
+  time_s REAL NOT NULL,
+  stage TEXT NOT NULL,
+  name TEXT NOT NULL,
+  wave_type TEXT NOT NULL CHECK (wave_type IN ('P', 'S')),
+  propagation_axis INTEGER NOT NULL,
+  polarisation_axis INTEGER NOT NULL,
+  frequency_hz REAL NOT NULL,
+  amplitude_m_per_s REAL NOT NULL,
+  dt_s REAL NOT NULL,
+  velocity_xcorr_m_per_s REAL,
+  velocity_first_break_m_per_s REAL,
+  source BLOB NOT NULL
+);
+CREATE INDEX waves_by_run ON waves (run_id, step);
+CREATE TABLE traces (
+  wave_id INTEGER NOT NULL REFERENCES waves(id) ON DELETE CASCADE,
+  receiver INTEGER NOT NULL,
+  distance_m REAL NOT NULL,
+  particles INTEGER NOT NULL,
+  picked_samples INTEGER NOT NULL,
+  samples BLOB NOT NULL,
+  PRIMARY KEY (wave_id, receiver)
+);
+CREATE TABLE picks (
+  wave_id INTEGER NOT NULL REFERENCES waves(id) ON DELETE CASCADE,
+  receiver INTEGER NOT NULL,
+  method TEXT NOT NULL CHECK (method IN ('xcorr', 'first_break')),
+  time_s REAL NOT NULL,
+  quality REAL,
+  PRIMARY KEY (wave_id, receiver, method)
+);
+)sql",
   };
   return m;
 }
@@ -271,6 +310,41 @@ void RunWriter::snapshot(std::string_view kind, std::string_view stage, std::str
       "VALUES (?, ?, ?, ?, ?, ?, ?)");
   s.bind(1, id_).bind(2, step).bind(3, time).bind(4, stage).bind(5, label).bind(6, kind);
   s.bind(7, relative).run();
+}
+
+std::int64_t RunWriter::wave(const WaveRow& w) {
+  auto& db = nb_.db();
+  Transaction tx(db);
+  auto ws = db.prepare(
+      "INSERT INTO waves (run_id, step, time_s, stage, name, wave_type, propagation_axis, "
+      "polarisation_axis, frequency_hz, amplitude_m_per_s, dt_s, velocity_xcorr_m_per_s, "
+      "velocity_first_break_m_per_s, source) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  ws.bind(1, id_).bind(2, w.step).bind(3, w.time).bind(4, w.stage).bind(5, w.name);
+  ws.bind(6, w.type).bind(7, w.propagation_axis).bind(8, w.polarisation_axis);
+  ws.bind(9, w.frequency).bind(10, w.amplitude).bind(11, w.dt).bind(12, w.velocity_xcorr);
+  ws.bind(13, w.velocity_first_break).bindDoubles(14, w.source).run();
+  const std::int64_t wave_id = db.lastInsertId();
+  auto ts = db.prepare(
+      "INSERT INTO traces (wave_id, receiver, distance_m, particles, picked_samples, samples) "
+      "VALUES (?, ?, ?, ?, ?, ?)");
+  auto ps = db.prepare(
+      "INSERT INTO picks (wave_id, receiver, method, time_s, quality) VALUES (?, ?, ?, ?, ?)");
+  for (std::size_t r = 0; r < w.receivers.size(); ++r) {
+    const WaveRow::Receiver& x = w.receivers[r];
+    const auto index = static_cast<std::int64_t>(r);
+    ts.bind(1, wave_id).bind(2, index).bind(3, x.distance).bind(4, x.particles);
+    ts.bind(5, x.picked_samples).bindDoubles(6, x.samples).run();
+    if (x.xcorr_time) {
+      ps.bind(1, wave_id).bind(2, index).bind(3, "xcorr").bind(4, *x.xcorr_time);
+      ps.bind(5, x.xcorr_quality).run();
+    }
+    if (x.first_break_time) {
+      ps.bind(1, wave_id).bind(2, index).bind(3, "first_break").bind(4, *x.first_break_time);
+      ps.bindNull(5).run();
+    }
+  }
+  tx.commit();
+  return wave_id;
 }
 
 void RunWriter::flushIfDue() {

@@ -16,7 +16,7 @@
 
 namespace rocklab::notebook {
 
-inline constexpr int kSchemaVersion = 4;
+inline constexpr int kSchemaVersion = 5;
 
 // Opens a lab notebook, creating it if needed, and brings its schema up to date. Runs a
 // previous process left `running` on this host and that process is gone are marked failed.
@@ -70,6 +70,28 @@ struct EventRow {
   double value = 0.0;    // e.g. the stress that broke the bond (Pa)
 };
 
+// One ultrasonic measurement (the `waves`, `traces` and `picks` tables): a pulse sent through
+// a copy of the sample at a loading stage, the receivers' traces and their arrival picks.
+struct WaveRow {
+  std::uint64_t step = 0;  // the loading step whose state was copied
+  double time = 0.0;
+  std::string stage;  // e.g. "stage 3"
+  std::string name;   // pz, px, szx, sxy
+  std::string type;   // P or S
+  int propagation_axis = 0, polarisation_axis = 0;
+  double frequency = 0.0, amplitude = 0.0, dt = 0.0;           // Hz, m/s, s
+  std::optional<double> velocity_xcorr, velocity_first_break;  // m/s
+  std::vector<double> source;                                  // m/s, every dt
+  struct Receiver {
+    double distance = 0.0;  // m
+    std::int64_t particles = 0;
+    std::int64_t picked_samples = 0;  // samples before the far end's echo
+    std::vector<double> samples;      // m/s, every dt
+    std::optional<double> xcorr_time, xcorr_quality, first_break_time;  // s, -, s
+  };
+  std::vector<Receiver> receivers;
+};
+
 // Records one run. Rows are buffered and written in batched transactions (flush() or
 // automatically past a batch size); finish() writes the rest and closes the run with its
 // status. A writer destroyed without finish() marks the run failed.
@@ -86,6 +108,8 @@ class RunWriter {
   void message(std::uint64_t step, double time, std::string_view level, std::string_view text);
   void result(std::string_view name, double value, std::string_view unit);
   void stageTiming(std::string_view stage, double seconds, std::uint64_t calls);
+  // Writes a wave with its traces and picks at once (one transaction); returns its id.
+  std::int64_t wave(const WaveRow& w);
   // Writes a file of the run (a state frame, kind "frame") and records it in `snapshots`.
   void snapshot(std::string_view kind, std::string_view stage, std::string_view label,
                 std::uint64_t step, double time, const std::string& bytes,

@@ -103,6 +103,54 @@ Table eventsOf(Notebook& nb, std::int64_t run, const std::string& kind) {
   return drain(s);
 }
 
+std::vector<WaveRow> wavesOf(Notebook& nb, std::int64_t run) {
+  requireRun(nb, run);
+  auto ws = nb.db().prepare(
+      "SELECT id, step, time_s, stage, name, wave_type, propagation_axis, polarisation_axis, "
+      "frequency_hz, amplitude_m_per_s, dt_s, velocity_xcorr_m_per_s, "
+      "velocity_first_break_m_per_s, source FROM waves WHERE run_id = ? ORDER BY id");
+  ws.bind(1, run);
+  auto ts = nb.db().prepare(
+      "SELECT t.distance_m, t.particles, t.picked_samples, t.samples, x.time_s, x.quality, "
+      "f.time_s FROM traces t "
+      "LEFT JOIN picks x ON x.wave_id = t.wave_id AND x.receiver = t.receiver AND x.method = "
+      "'xcorr' "
+      "LEFT JOIN picks f ON f.wave_id = t.wave_id AND f.receiver = t.receiver AND f.method = "
+      "'first_break' "
+      "WHERE t.wave_id = ? ORDER BY t.receiver");
+  auto optional = [](const Statement& s, int c) {
+    return s.isNull(c) ? std::nullopt : std::optional<double>(s.real(c));
+  };
+  std::vector<WaveRow> out;
+  while (ws.step()) {
+    WaveRow w;
+    w.step = static_cast<std::uint64_t>(ws.integer(1));
+    w.time = ws.real(2);
+    w.stage = ws.text(3), w.name = ws.text(4), w.type = ws.text(5);
+    w.propagation_axis = static_cast<int>(ws.integer(6));
+    w.polarisation_axis = static_cast<int>(ws.integer(7));
+    w.frequency = ws.real(8), w.amplitude = ws.real(9), w.dt = ws.real(10);
+    w.velocity_xcorr = optional(ws, 11);
+    w.velocity_first_break = optional(ws, 12);
+    w.source = ws.doubles(13);
+    ts.bind(1, ws.integer(0));
+    while (ts.step()) {
+      WaveRow::Receiver r;
+      r.distance = ts.real(0);
+      r.particles = ts.integer(1);
+      r.picked_samples = ts.integer(2);
+      r.samples = ts.doubles(3);
+      r.xcorr_time = optional(ts, 4);
+      r.xcorr_quality = optional(ts, 5);
+      r.first_break_time = optional(ts, 6);
+      w.receivers.push_back(std::move(r));
+    }
+    ts.reset();
+    out.push_back(std::move(w));
+  }
+  return out;
+}
+
 namespace {
 
 std::string csvField(const std::string& s) {

@@ -20,6 +20,8 @@ Table listRuns(Notebook& nb);
 std::vector<std::pair<std::string, Table>> showRun(Notebook& nb, std::int64_t run);
 Table seriesOf(Notebook& nb, std::int64_t run, const std::vector<std::string>& names);
 Table eventsOf(Notebook& nb, std::int64_t run, const std::string& kind);
+// The run's ultrasonic measurements with their traces and picks, in the order recorded.
+std::vector<WaveRow> wavesOf(Notebook& nb, std::int64_t run);
 // Throws when the run does not exist, naming the lab.
 void requireRun(Notebook& nb, std::int64_t run);
 

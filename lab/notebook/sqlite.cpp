@@ -1,6 +1,8 @@
 #include "lab/notebook/sqlite.hpp"
 
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 namespace rocklab::notebook {
@@ -56,6 +58,22 @@ Statement& Statement::bind(int index, std::string_view v) {
   return *this;
 }
 
+static_assert(std::endian::native == std::endian::little,
+              "traces are stored as little-endian float64 BLOBs");
+
+Statement& Statement::bindDoubles(int index, const std::vector<double>& v) {
+  check(sqlite3_bind_blob64(stmt_, index, v.data(), v.size() * sizeof(double), SQLITE_TRANSIENT),
+        "bind");
+  return *this;
+}
+
+std::vector<double> Statement::doubles(int c) const {
+  const auto bytes = static_cast<std::size_t>(sqlite3_column_bytes(stmt_, c));
+  std::vector<double> v(bytes / sizeof(double));
+  if (!v.empty()) std::memcpy(v.data(), sqlite3_column_blob(stmt_, c), v.size() * sizeof(double));
+  return v;
+}
+
 Statement& Statement::bindNull(int index) {
   check(sqlite3_bind_null(stmt_, index), "bind");
   return *this;
@@ -104,6 +122,10 @@ Cell Statement::cell(int c) const {
       x.real = real(c);
       break;
     case SQLITE_NULL:
+      break;
+    case SQLITE_BLOB:  // samples: shown by size, read with doubles()
+      x.type = Cell::Type::Text;
+      x.text = "<" + std::to_string(sqlite3_column_bytes(stmt_, c)) + " bytes>";
       break;
     default:
       x.type = Cell::Type::Text;

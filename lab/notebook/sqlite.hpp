@@ -42,6 +42,8 @@ class Statement {
   Statement& bind(int index, std::string_view v);
   Statement& bind(int index, const char* v) { return bind(index, std::string_view(v)); }
   Statement& bindNull(int index);
+  // Samples as a BLOB of little-endian float64 (this machine's order, checked at build).
+  Statement& bindDoubles(int index, const std::vector<double>& v);
   template <class T>
   Statement& bind(int index, const std::optional<T>& v) {
     return v ? bind(index, *v) : bindNull(index);
@@ -60,6 +62,7 @@ class Statement {
   double real(int c) const { return sqlite3_column_double(stmt_, c); }
   std::string text(int c) const;
   bool isNull(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_NULL; }
+  std::vector<double> doubles(int c) const;  // a BLOB written by bindDoubles
 
  private:
   void check(int rc, const char* what) const;

@@ -126,8 +126,8 @@ CrossCorrelation crossCorrelate(std::span<const double> x, std::span<const doubl
   return c;
 }
 
-Pick crossCorrelationPick(std::span<const double> wavelet, std::span<const double> trace,
-                          double dt) {
+Pick crossCorrelationPick(std::span<const double> wavelet, std::span<const double> trace, double dt,
+                          double first_peak_fraction) {
   requireStep(dt);
   Pick p;
   double ex = 0.0, ey = 0.0;
@@ -137,8 +137,18 @@ Pick crossCorrelationPick(std::span<const double> wavelet, std::span<const doubl
   const CrossCorrelation c = crossCorrelate(wavelet, trace);
   // Causal lags only: a receiver cannot hear the source before it sounds.
   const auto zero = static_cast<std::size_t>(-c.first_lag);
-  const auto peak = static_cast<std::size_t>(
+  auto peak = static_cast<std::size_t>(
       std::max_element(c.r.begin() + static_cast<std::ptrdiff_t>(zero), c.r.end()) - c.r.begin());
+  if (first_peak_fraction < 1.0) {
+    const double level = first_peak_fraction * c.r[peak];
+    for (std::size_t i = zero; i < peak; ++i) {
+      const bool local_max = (i == zero || c.r[i] >= c.r[i - 1]) && c.r[i] >= c.r[i + 1];
+      if (local_max && c.r[i] >= level) {
+        peak = i;
+        break;
+      }
+    }
+  }
   double shift = 0.0;
   if (peak > zero && peak + 1 < c.r.size()) {
     const double a = c.r[peak - 1], b = c.r[peak], g = c.r[peak + 1];
@@ -147,7 +157,14 @@ Pick crossCorrelationPick(std::span<const double> wavelet, std::span<const doubl
   }
   p.found = true;
   p.time = (static_cast<double>(peak - zero) + shift) * dt;
-  p.quality = c.r[peak] / std::sqrt(ex * ey);
+  // Normalised by the trace's energy under the wavelet at that lag (the local normalised
+  // cross-correlation): the match there, whatever else the trace holds elsewhere.
+  const std::size_t lag = peak - zero;
+  double local = 0.0;
+  for (std::size_t i = lag; i < std::min(trace.size(), lag + wavelet.size()); ++i) {
+    local += trace[i] * trace[i];
+  }
+  p.quality = local > 0.0 ? c.r[peak] / std::sqrt(ex * local) : 0.0;
   return p;
 }
 

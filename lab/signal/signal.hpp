@@ -27,7 +27,8 @@ CrossCorrelation crossCorrelate(std::span<const double> x, std::span<const doubl
 struct Pick {
   bool found = false;
   double time = 0.0;     // s, from the first sample
-  double quality = 0.0;  // cross-correlation: normalised coefficient at the peak, in [-1, 1];
+  double quality = 0.0;  // cross-correlation: coefficient at the peak normalised by the
+                         // wavelet's energy and the trace's under it, in [-1, 1];
                          // first break: the trace's peak magnitude
 };
 
@@ -35,8 +36,11 @@ struct Pick {
 // lag >= 0 of the largest cross-correlation, refined between samples by the parabola
 // through the peak and its two neighbours (J. O. Smith, "Spectral Audio Signal Processing",
 // quadratic interpolation of spectral peaks).
-Pick crossCorrelationPick(std::span<const double> wavelet, std::span<const double> trace,
-                          double dt);
+// With `first_peak_fraction` < 1 the pick is the earliest local maximum reaching that
+// fraction of the largest: the direct arrival, when a later event (an echo, a burst of
+// breaking bonds) correlates better.
+Pick crossCorrelationPick(std::span<const double> wavelet, std::span<const double> trace, double dt,
+                          double first_peak_fraction = 1.0);
 
 // The first break: the first instant the trace's magnitude reaches `fraction` of its peak
 // magnitude, interpolated linearly between the two samples around the crossing.

@@ -27,5 +27,6 @@ std::vector<Figure> hydrostaticFigures(const std::vector<const RunData*>& runs, 
 std::vector<Figure> biaxialFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> envelopeFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> permeameterFigures(const std::vector<const RunData*>& runs, const Paper& paper);
+std::vector<Figure> ultrasonicFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 
 }  // namespace rocklab::reports

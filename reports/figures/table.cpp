@@ -6,7 +6,7 @@ const std::vector<FigureEntry>& figureTable() {
   static const std::vector<FigureEntry> table = {
       {"oedometer", oedometerFigures},     {"hydrostatic", hydrostaticFigures},
       {"biaxial", biaxialFigures},         {"envelope", envelopeFigures},
-      {"permeameter", permeameterFigures},
+      {"permeameter", permeameterFigures}, {"ultrasonic", ultrasonicFigures},
   };
   return table;
 }

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "lab/core/frame.hpp"
 
@@ -22,6 +23,25 @@ struct EventRecord {
   double value = 0.0;
 };
 
+// An ultrasonic measurement (rigs/ultrasonic): the pulse, each receiver's trace and picks.
+struct WaveRecord {
+  std::uint64_t step = 0;  // the loading step whose state was copied
+  double time = 0.0;
+  std::string stage, name, type;  // e.g. "stage 3", "pz", "P"
+  int propagation_axis = 0, polarisation_axis = 0;
+  double frequency = 0.0, amplitude = 0.0, dt = 0.0;        // Hz, m/s, s
+  double velocity_xcorr = 0.0, velocity_first_break = 0.0;  // m/s, 0: none
+  std::vector<double> source;                               // m/s, every dt
+  struct Receiver {
+    double distance = 0.0;  // m
+    std::size_t particles = 0, picked_samples = 0;
+    std::vector<double> samples;  // m/s, every dt
+    bool xcorr_found = false, first_break_found = false;
+    double xcorr_time = 0.0, xcorr_quality = 0.0, first_break_time = 0.0;
+  };
+  std::vector<Receiver> receivers;
+};
+
 class Recorder {
  public:
   virtual ~Recorder() = default;
@@ -33,6 +53,7 @@ class Recorder {
   virtual void stageTiming(std::string_view stage, double seconds, std::uint64_t calls) = 0;
   // A frame of the state for reports and ParaView (`label` says which moment it is).
   virtual void snapshot(std::string_view stage, std::string_view label, const Frame& frame) = 0;
+  virtual void wave(const WaveRecord& w) = 0;
 };
 
 // Raised when the user interrupts a run (Ctrl-C, SIGTERM); the run is closed as

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 namespace rocklab::rigs::ultrasonic {
 
@@ -77,12 +78,22 @@ double meanVelocity(const Simulation<D>& sim, const std::vector<std::uint32_t>& 
 
 // Picks on each receiver's trace up to its cut, and the velocity from them.
 void pick(WaveResult& w) {
+  // The wavelet is the pulse itself, not the silence after it.
+  const auto pulse = static_cast<std::size_t>(std::ceil(1.0 / (w.spec.frequency * w.dt))) + 1;
+  const std::span<const double> wavelet(w.source.data(), std::min(pulse, w.source.size()));
   std::vector<double> distance;
   std::vector<signal::Pick> xc, fb;
   for (ReceiverTrace& r : w.receivers) {
     const std::span<const double> trace(r.velocity.data(), r.picked_samples);
-    r.xcorr = signal::crossCorrelationPick(w.source, trace, w.dt);
-    r.first_break = signal::firstBreakPick(trace, w.dt, w.spec.first_break_fraction);
+    r.xcorr = signal::crossCorrelationPick(wavelet, trace, w.dt, w.spec.first_peak_fraction);
+    if (r.xcorr.quality < w.spec.min_xcorr_quality) r.xcorr.found = false;
+    // The first break's level is a fraction of the direct pulse's peak: the trace up to one
+    // source length past the cross-correlation pick, when there is one.
+    std::size_t direct = trace.size();
+    if (r.xcorr.found) {
+      direct = std::min(direct, static_cast<std::size_t>(r.xcorr.time / w.dt) + wavelet.size());
+    }
+    r.first_break = signal::firstBreakPick(trace.first(direct), w.dt, w.spec.first_break_fraction);
     distance.push_back(r.distance);
     xc.push_back(r.xcorr);
     fb.push_back(r.first_break);
@@ -134,6 +145,8 @@ WaveResult measureWave(Simulation<D>& sim, const WaveSpec& spec) {
     w.receivers.push_back(std::move(r));
   }
   sim.drive(source);
+  std::optional<Simulation<D>> background;
+  if (spec.subtract_background) background.emplace(sim.clone());
   w.dt = sim.dt();
   const double period = 1.0 / spec.frequency, omega = 2.0 * std::numbers::pi * spec.frequency;
   Vec<D> direction = Vec<D>::Zero();
@@ -172,15 +185,28 @@ WaveResult measureWave(Simulation<D>& sim, const WaveSpec& spec) {
       break;
     }
   }
+  if (background) {
+    background->setDrivenVelocity(source, Vec<D>::Zero());
+    for (std::uint64_t n = 0; n < w.steps; ++n) {
+      background->step();
+      for (std::size_t r = 0; r < receivers.size(); ++r) {
+        const double v = meanVelocity(*background, receivers[r], spec.polarisation);
+        w.receivers[r].velocity[n] -= v;
+        w.receivers[r].background_peak = std::max(w.receivers[r].background_peak, std::abs(v));
+      }
+    }
+  }
   // First picks on whole traces; then each trace is cut where the echo from the sample's far
-  // end can first reach it (out to the end and back: 2 L_far - d at the first velocity) and
-  // picked again, so an echo cannot pass for the arrival.
+  // end can first reach it (out to the end and back: 2 L_far - d), and picked again, so an
+  // echo cannot pass for the arrival. The echo is timed with the faster of the two first
+  // velocities: a first break is read off the leading edge, which no echo precedes.
   for (ReceiverTrace& r : w.receivers) r.picked_samples = r.velocity.size();
   pick(w);
-  if (w.xcorr.value > 0.0) {
+  const signal::Velocity& fast = w.first_break.value > w.xcorr.value ? w.first_break : w.xcorr;
+  if (fast.value > 0.0) {
     const double far = spec.path_hi - source_centre;
     for (ReceiverTrace& r : w.receivers) {
-      const double echo = w.xcorr.delay + (2.0 * far - r.distance) / w.xcorr.value;
+      const double echo = fast.delay + (2.0 * far - r.distance) / fast.value;
       const auto cut = static_cast<std::size_t>(std::max(0.0, echo / w.dt));
       r.picked_samples = std::clamp<std::size_t>(cut, 1, r.velocity.size());
     }

@@ -34,11 +34,22 @@ struct WaveSpec {
   double receiver_half_width = 0.0;
   std::vector<double> centre;         // m, the sample's centre (D values) for receiver_half_width
   double first_break_fraction = 0.1;  // of each trace's peak magnitude
+  // A cross-correlation pick whose normalised coefficient is below this matched noise, not
+  // the pulse: it is left out of the velocity fit.
+  double min_xcorr_quality = 0.75;  // a half-period misfit scores 1/sqrt(2)
+  // The arrival is the earliest correlation peak reaching this fraction of the largest
+  // (signal::crossCorrelationPick): a late burst cannot pass for it.
+  double first_peak_fraction = 0.6;
   // The farthest receiver has heard the wave when its magnitude reaches this fraction of
-  // the nearest one's peak; recording goes on `tail_periods` pulse periods after that.
+  // the nearest one's peak; recording goes on `tail_periods` pulse periods after that:
+  // enough for the pulse's main lobe, and short, because in a sample near failure the pulse
+  // can set off an avalanche of breaks whose motion, later and louder, would bury it.
   double arrival_fraction = 0.1;
-  double tail_periods = 2.0;
+  double tail_periods = 1.25;
   std::uint64_t max_steps = 200000;
+  // The receivers' own motion without the pulse (a loaded sample still creeps and rings when
+  // its walls stop) comes from a second copy run without it, and is subtracted.
+  bool subtract_background = true;
   int frames = 0;  // wave-front frames: one every pulse period from the pulse's end
 };
 
@@ -46,6 +57,7 @@ struct ReceiverTrace {
   double distance = 0.0;  // m, from the source slab's centre
   std::size_t particles = 0;
   std::vector<double> velocity;    // m/s, mean along the polarisation, every step
+  double background_peak = 0.0;    // m/s, largest background velocity subtracted
   std::size_t picked_samples = 0;  // samples before the far end's echo can arrive
   signal::Pick xcorr, first_break;
 };

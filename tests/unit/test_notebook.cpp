@@ -106,6 +106,52 @@ TEST_F(NotebookTest, SnapshotFilesLiveBesideTheNotebookAndAreRecorded) {
   std::filesystem::remove_all(nb.runFilesDir(1));
 }
 
+TEST_F(NotebookTest, WavesKeepTheirTracesAndPicksSampleForSample) {
+  Notebook nb(path_);
+  RunWriter w(nb, info(), {});
+  WaveRow row;
+  row.step = 77, row.time = 1e-3, row.stage = "stage 2", row.name = "szx", row.type = "S";
+  row.propagation_axis = 2, row.polarisation_axis = 0;
+  row.frequency = 2e5, row.amplitude = 1e-3, row.dt = 1e-8;
+  row.velocity_xcorr = 812.5;  // no first-break velocity: stored as NULL
+  row.source = {0.0, 0.5, -0.25, 1.0 / 3.0};
+  for (int r = 0; r < 3; ++r) {
+    WaveRow::Receiver x;
+    x.distance = 1e-3 * (r + 1), x.particles = 10 + r, x.picked_samples = 2 + r;
+    x.samples = {0.1 * r, -1e-300, 3.0e10, 0.0, 7.0};
+    if (r != 1) x.xcorr_time = 1e-6 * r, x.xcorr_quality = 0.9;
+    x.first_break_time = 5e-7 * r;
+    row.receivers.push_back(x);
+  }
+  const std::int64_t id = w.wave(row);
+  w.finish(RunStatus::Completed);
+  EXPECT_EQ(id, 1);
+  EXPECT_EQ(scalar(nb, "SELECT count(*) FROM picks"), "5");
+  EXPECT_EQ(scalar(nb, "SELECT samples FROM traces LIMIT 1"), "<40 bytes>");
+  const std::vector<WaveRow> back = wavesOf(nb, 1);
+  ASSERT_EQ(back.size(), 1u);
+  const WaveRow& b = back[0];
+  EXPECT_EQ(b.step, 77u);
+  EXPECT_EQ(b.stage + b.name + b.type, "stage 2szxS");
+  EXPECT_EQ(b.propagation_axis, 2);
+  EXPECT_EQ(b.velocity_xcorr, row.velocity_xcorr);
+  EXPECT_FALSE(b.velocity_first_break);
+  EXPECT_EQ(b.source, row.source);  // bit for bit
+  ASSERT_EQ(b.receivers.size(), 3u);
+  for (int r = 0; r < 3; ++r) {
+    EXPECT_EQ(b.receivers[r].samples, row.receivers[r].samples);
+    EXPECT_EQ(b.receivers[r].picked_samples, 2 + r);
+    EXPECT_EQ(b.receivers[r].xcorr_time, row.receivers[r].xcorr_time);
+    EXPECT_EQ(b.receivers[r].first_break_time, row.receivers[r].first_break_time);
+  }
+  // Deleting the run takes its waves, traces and picks with it.
+  nb.db().exec("DELETE FROM runs");
+  EXPECT_EQ(scalar(nb,
+                   "SELECT (SELECT count(*) FROM waves) + (SELECT count(*) FROM traces) + "
+                   "(SELECT count(*) FROM picks)"),
+            "0");
+}
+
 TEST_F(NotebookTest, AWriterLeftOpenMarksTheRunFailedAndKeepsItsData) {
   Notebook nb(path_);
   {
