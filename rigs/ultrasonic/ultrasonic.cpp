@@ -66,8 +66,12 @@ void declare(protocol::Schema& s) {
         0, false, 20, false);
   s.flag("static.enabled", true,
          "measure static moduli by small strain cycles (lateral walls held) at each stage");
-  range(s.real("static.strain_amplitude", "-", 1, 1e-5,
-               "strain of the static cycle: small, to stay in the elastic range"),
+  // 1e-5 was lost in what is left of the unbalanced force at "rest": the loading and
+  // unloading slopes disagreed and fell with stress. At 1e-4 they agree within 2% (measured
+  // on ultrasonic-hydrostatic-quick), still a tenth of a Hertzian overlap at 0.5 MPa.
+  range(s.real("static.strain_amplitude", "-", 1, 1e-4,
+               "strain of the static cycle: small, to stay in the elastic range, but large "
+               "enough to stand out of the residual unbalanced force"),
         0, true, 1e-2, false);
   // The moduli come from rest states between the moves (each move is followed by a hold
   // until the copy is at rest), so the rate only sets how long a move takes.
