@@ -157,16 +157,16 @@ Figure traces(const RunData& r) {
   return f;
 }
 
-// Amplitude spectra of the source and the nearest and farthest receivers, each normalised
+// Amplitude spectra of the source and of a near and a far receiver, each normalised
 // to its peak: the pack filters the pulse's high frequencies on the way.
 Figure spectra(const RunData& r) {
   Figure f;
   f.id = "ultrasonic-spectra-run" + std::to_string(r.id);
   f.title = "Amplitude spectra at the last stage, " + r.label();
   f.caption =
-      "FFT amplitude of the source pulse and of the nearest and farthest receivers' traces "
-      "(up to the far end's echo), each normalised to its peak; the pulse's nominal frequency "
-      "is the wave.frequency_kHz of the protocol.";
+      "FFT amplitude of the source pulse, of the nearest receiver's trace and of the farthest "
+      "one whose whole pulse arrives before the far end's echo, each normalised to its peak; "
+      "the pulse's nominal frequency is the wave.frequency_kHz of the protocol.";
   for (const notebook::WaveRow* w : lastStage(r)) {
     if (w->receivers.empty()) continue;
     Panel p{"frequency (kHz)", w->name + ": amplitude / peak", {}};
@@ -184,10 +184,20 @@ Figure spectra(const RunData& r) {
       p.series.push_back(line);
     };
     add("source", w->source, w->source.size());
+    // The farthest receiver whose whole pulse lies before the echo cut: a pulse cut in half
+    // would show the cut's spectrum, not the pack's filtering.
+    const double period = 1.0 / (w->frequency * w->dt);  // samples
+    const notebook::WaveRow::Receiver* far = nullptr;
+    for (const auto& rc : w->receivers) {
+      if (rc.xcorr_time && *rc.xcorr_time / w->dt + 1.5 * period <= rc.picked_samples) far = &rc;
+    }
     const auto& near = w->receivers.front();
-    const auto& far = w->receivers.back();
     add("nearest receiver", near.samples, static_cast<std::size_t>(near.picked_samples));
-    add("farthest receiver", far.samples, static_cast<std::size_t>(far.picked_samples));
+    if (far && far != &near) {
+      add("receiver at " + std::to_string(static_cast<int>(std::lround(far->distance * 1e3))) +
+              " mm",
+          far->samples, static_cast<std::size_t>(far->picked_samples));
+    }
     f.panels.push_back(p);
   }
   return f;

@@ -602,6 +602,27 @@ TEST(QuickProtocols, UltrasonicVelocitiesRiseWithHydrostaticStress) {
   ASSERT_EQ(m.size(), 3u);
   EXPECT_GT(m.back(), m.front());
   EXPECT_GE(result(n, "wavelength_min_diameters"), 4.0);
+  // The report draws the bench's figures with their data, and the wave fronts (Figure 17).
+  const std::string rep = lab.path + "-report";
+  std::string out;
+  ASSERT_EQ(rocklab::testing::runRocklab("report 1 --lab " + lab.path + " --out " + rep, &out), 0)
+      << out;
+  for (const char* id : {"ultrasonic-velocities-run1", "ultrasonic-moduli-run1",
+                         "ultrasonic-traces-run1", "ultrasonic-spectra-run1"}) {
+    EXPECT_TRUE(std::filesystem::exists(rep + "/" + id + ".png")) << id;
+    std::ifstream csv(rep + "/" + id + ".csv");
+    std::string line;
+    int rows = 0;
+    while (std::getline(csv, line)) ++rows;
+    EXPECT_GT(rows, 10) << id;
+  }
+  int fronts = 0;
+  for (const auto& e : std::filesystem::directory_iterator(rep)) {
+    fronts += e.path().filename().string().rfind("run1-wave-", 0) == 0;
+  }
+  EXPECT_GE(fronts, 4);  // frames of each wave at the last stage
+  std::filesystem::remove_all(rep);
+  std::filesystem::remove_all(lab.path + ".files");
 }
 
 // Li & Holt Figure 18b: in uniaxial strain the weakly cemented sample fails at a few
