@@ -142,7 +142,8 @@ Pick crossCorrelationPick(std::span<const double> wavelet, std::span<const doubl
   if (first_peak_fraction < 1.0) {
     const double level = first_peak_fraction * c.r[peak];
     for (std::size_t i = zero; i < peak; ++i) {
-      const bool local_max = (i == zero || c.r[i] >= c.r[i - 1]) && c.r[i] >= c.r[i + 1];
+      // Lag 0 counts only as a peak of its own, not as the tail of one at negative lag.
+      const bool local_max = (i == 0 || c.r[i] >= c.r[i - 1]) && c.r[i] >= c.r[i + 1];
       if (local_max && c.r[i] >= level) {
         peak = i;
         break;

@@ -32,7 +32,7 @@ struct Pick {
                          // first break: the trace's peak magnitude
 };
 
-// The delay of `trace` behind `wavelet` (both sampled every dt from the same instant): the
+// The delay of `trace` behind `wavelet` (both sampled every dt, sample 0 at one instant): the
 // lag >= 0 of the largest cross-correlation, refined between samples by the parabola
 // through the peak and its two neighbours (J. O. Smith, "Spectral Audio Signal Processing",
 // quadratic interpolation of spectral peaks).

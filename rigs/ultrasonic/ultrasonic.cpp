@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "lab/signal/signal.hpp"
 #include "rigs/common/specimen.hpp"
@@ -46,8 +47,8 @@ void declare(protocol::Schema& s) {
                "thickness of the source and receiver slabs, in mean particle diameters"),
         0, true, 100, false);
   range(s.real("wave.receiver_half_width", "-", 1, 0.5,
-               "receivers keep the particles within this fraction of the sample's half width "
-               "of its axis (1: the whole section)"),
+               "receivers keep the particles within this fraction of the sample's smaller half "
+               "width of its axis (a disc in 3D)"),
         0, true, 10, false);
   range(s.real("wave.first_break_fraction", "-", 1, 0.1,
                "first-break level, as a fraction of each trace's peak magnitude"),
@@ -97,6 +98,10 @@ void requireAscending(const Settings& s, const std::string& key, double lo, doub
 }  // namespace
 
 void validate(const Settings& s) {
+  // A clump's pebbles move with their body: they can be neither driven nor weighed one by one.
+  if (s.text("sample.kind") == "clumps") {
+    protocol::fail(s, "sample.kind", "must be spheres or grains on the ultrasonic bench");
+  }
   const std::string& mode = s.text("loading.mode");
   if (mode == "hydrostatic") {
     requireAscending(s, "loading.stages_MPa", 0.0, 1e5, "MPa");

@@ -29,8 +29,8 @@ struct WaveSpec {
   std::vector<double> receivers_at{0.35, 0.5, 0.65, 0.8};  // receiver slab centres, likewise
   double slab = 0.0;  // m, thickness of the source and receiver slabs along the path
   // Receivers keep the particles within this distance of the sample's axis across the path
-  // (m; 0: the whole section). Inside the sample they hear the plane wave before anything
-  // the sides send (section 4.1: "the transmitter and receiver can be placed inside").
+  // (m, a disc in 3D; 0: the whole section). Inside the sample they hear the plane wave before
+  // anything the sides send (section 4.1: "the transmitter and receiver can be placed inside").
   double receiver_half_width = 0.0;
   std::vector<double> centre;         // m, the sample's centre (D values) for receiver_half_width
   double first_break_fraction = 0.1;  // of each trace's peak magnitude
@@ -57,7 +57,6 @@ struct ReceiverTrace {
   double distance = 0.0;  // m, from the source slab's centre
   std::size_t particles = 0;
   std::vector<double> velocity;    // m/s, mean along the polarisation, every step
-  double background_peak = 0.0;    // m/s, largest background velocity subtracted
   std::size_t picked_samples = 0;  // samples before the far end's echo can arrive
   signal::Pick xcorr, first_break;
 };
