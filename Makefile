@@ -3,6 +3,7 @@
 
 PACKAGES := build-essential cmake pkg-config git \
   libeigen3-dev libcgal-dev libvtk9-dev libosmesa6-dev libfftw3-dev \
+  libsuitesparse-dev libopenblas0-serial \
   libsqlite3-dev sqlite3 libgtest-dev libtoml11-dev libcli11-dev libbenchmark-dev
 
 PRESET ?= release

@@ -45,6 +45,18 @@ if(NOT FFTW3_FOUND)
   rocklab_missing("FFTW 3 (spectra and arrival picking)" "libfftw3-dev")
 endif()
 
+# CHOLMOD (SuiteSparse): the supernodal Cholesky of the pore network's pressure system, as
+# Yade's FlowEngine uses; Eigen's simplicial one fills in badly on 3D networks (45 s against
+# CHOLMOD's under a second at 116,000 pores). Debian ships no CMake or pkg-config file.
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse)
+find_library(CHOLMOD_LIBRARY cholmod)
+if(NOT CHOLMOD_INCLUDE_DIR OR NOT CHOLMOD_LIBRARY)
+  rocklab_missing("CHOLMOD (sparse Cholesky for the pore network)" "libsuitesparse-dev")
+endif()
+add_library(rocklab_cholmod INTERFACE)
+target_include_directories(rocklab_cholmod INTERFACE ${CHOLMOD_INCLUDE_DIR})
+target_link_libraries(rocklab_cholmod INTERFACE ${CHOLMOD_LIBRARY})
+
 find_package(SQLite3 QUIET)
 if(NOT SQLite3_FOUND)
   rocklab_missing("SQLite 3 (the lab notebook)" "libsqlite3-dev")

@@ -7,7 +7,14 @@
 #include <ostream>
 #include <stdexcept>
 
+#include <sys/resource.h>
+
+#include <algorithm>
+
+#include "lab/core/frame.hpp"
 #include "lab/core/simulation.hpp"
+#include "lab/flow/coupling.hpp"
+#include "reports/snapshot.hpp"
 
 namespace rocklab {
 
@@ -21,6 +28,10 @@ constexpr double kFriction = 0.5;    // particle-particle; walls are frictionles
 constexpr double kRestitution = 0.5;
 constexpr double kTimeStep = 1.9e-7;  // s, 20% of the Rayleigh time of r = 0.9 mm
 constexpr double kStrainRate = 1.0;   // 1/s, each wall moves in at edot * L / 2
+// The bonded variant: PFC-like cement stiff enough to matter (E 10 GPa, lambda 1) and too
+// strong to break in the timed phase, so it measures the bonds' force pass alone.
+constexpr double kBondModulus = 10e9;   // Pa
+constexpr double kBondStrength = 1e12;  // Pa
 
 // The damping ratio that gives restitution e for a linear dashpot; with Tsuji's Hertz
 // dashpot the peers use the same beta (LIGGGHTS and Yade).
@@ -144,6 +155,44 @@ Packing<3> benchPacking(std::size_t n, std::uint64_t seed, int threads) {
   return dense;
 }
 
+Packing<3> tilePacking(const Packing<3>& packing, const std::array<int, 3>& tile) {
+  if (tile == std::array<int, 3>{1, 1, 1}) return packing;
+  const Eigen::Vector3d size = packing.hi - packing.lo;
+  Packing<3> out;
+  out.lo = packing.lo;
+  out.hi = packing.lo;
+  for (int d = 0; d < 3; ++d) {
+    if (tile[d] < 1) throw std::invalid_argument("--tile: every count must be at least 1");
+    out.hi[d] += tile[d] * size[d];
+  }
+  const std::size_t copies = static_cast<std::size_t>(tile[0]) * tile[1] * tile[2];
+  out.centers.reserve(copies * packing.centers.size());
+  out.radii.reserve(copies * packing.radii.size());
+  for (int z = 0; z < tile[2]; ++z) {
+    for (int y = 0; y < tile[1]; ++y) {
+      for (int x = 0; x < tile[0]; ++x) {
+        const std::array<int, 3> k{x, y, z};
+        for (std::size_t i = 0; i < packing.centers.size(); ++i) {
+          Eigen::Vector3d c = packing.centers[i] - packing.lo;
+          for (int d = 0; d < 3; ++d) {
+            if (k[d] % 2 == 1) c[d] = size[d] - c[d];  // mirrored: see the header
+            c[d] += packing.lo[d] + k[d] * size[d];
+          }
+          out.centers.push_back(c);
+          out.radii.push_back(packing.radii[i]);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+double peakRssBytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return 1024.0 * static_cast<double>(u.ru_maxrss);  // Linux reports KiB
+}
+
 BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int threads) {
   SimulationConfig cfg;
   cfg.contact_law = "hertz";
@@ -153,13 +202,19 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
   cfg.threads = threads;
   cfg.track_energy = options.energy;
   Simulation<3> sim = makeScene(packing, kFriction, cfg);
+  BenchResult r;
+  if (options.bonded) {
+    BondKind cement;
+    cement.modulus = kBondModulus;
+    cement.tensile_mean = cement.shear_mean = kBondStrength;
+    r.bonds = sim.cement(sim.addBondKind(cement), 0.0).installed;
+  }
   const Eigen::Vector3d extent = boxExtent(sim);
   for (int w = 0; w < 6; ++w) {
     sim.wall(w).velocity = kStrainRate * extent[w / 2] / 2.0 * sim.wall(w).normal;
   }
   sim.run(options.warmup);
 
-  BenchResult r;
   r.threads = threads;
   r.particles = sim.particles().size();
   r.steps = options.steps;
@@ -176,10 +231,70 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
   r.wall_stress_end = meanWallStress(sim);
   r.rebuilds = sim.contacts().rebuilds - rebuilds;
   r.state_hash = sim.stateHash();
+  r.peak_rss_bytes = peakRssBytes();
   return r;
 }
 
-void printBench(std::ostream& out, const std::vector<BenchResult>& results, bool json,
+FlowBenchResult runFlowBench(const Packing<3>& packing) {
+  SimulationConfig cfg;
+  cfg.contact_law = "hertz";
+  cfg.track_energy = false;
+  const Simulation<3> sim = makeScene(packing, kFriction, cfg);
+  flow::FlowCoupling<3> coupling{flow::FlowSettings{}};
+  const flow::FlowReading first = coupling.measure(sim);
+  const flow::FlowReading repeat = coupling.measure(sim);
+  FlowBenchResult r;
+  r.particles = packing.centers.size();
+  r.pores = first.pores;
+  r.pipes = first.pipes;
+  r.clusters = first.clusters;
+  r.first_network_seconds = first.network_seconds;
+  r.first_solve_seconds = first.solve.seconds;
+  r.repeat_network_seconds = repeat.network_seconds;
+  r.repeat_solve_seconds = repeat.solve.seconds;
+  r.permeability = first.permeability;
+  // Kozeny-Carman with the constant 180 (the peers' reference): k = d^2 n^3 / (180 (1-n)^2),
+  // d the mean diameter, n the porosity of the box.
+  double solid = 0.0, diameter = 0.0;
+  for (double rad : packing.radii) {
+    solid += 4.0 / 3.0 * std::numbers::pi * rad * rad * rad;
+    diameter += 2.0 * rad;
+  }
+  diameter /= static_cast<double>(packing.radii.size());
+  const Eigen::Vector3d e = packing.hi - packing.lo;
+  const double n = 1.0 - solid / (e[0] * e[1] * e[2]);
+  r.kozeny_carman = diameter * diameter * n * n * n / (180.0 * (1.0 - n) * (1.0 - n));
+  r.peak_rss_bytes = peakRssBytes();
+  return r;
+}
+
+RenderBenchResult runRenderBench(const Packing<3>& packing, const std::string& folder) {
+  SimulationConfig cfg;
+  cfg.contact_law = "hertz";
+  cfg.track_energy = false;
+  const Simulation<3> sim = makeScene(packing, kFriction, cfg);
+  const Frame frame = captureFrame(sim);
+  reports::FieldValues field;
+  field.label = "height (mm)";
+  field.lo = 1e3 * packing.lo[2];
+  field.hi = 1e3 * packing.hi[2];
+  for (const auto& x : frame.pos) field.values.push_back(1e3 * x[2]);
+  RenderBenchResult r;
+  r.particles = frame.size();
+  const auto t0 = std::chrono::steady_clock::now();
+  reports::renderView(frame, field, {}, "benchmark packing", folder + "/bench-view.png");
+  const auto t1 = std::chrono::steady_clock::now();
+  reports::renderSlice(frame, field, {}, "benchmark packing", folder + "/bench-slice.png");
+  const auto t2 = std::chrono::steady_clock::now();
+  r.view_seconds = std::chrono::duration<double>(t1 - t0).count();
+  r.slice_seconds = std::chrono::duration<double>(t2 - t1).count();
+  r.peak_rss_bytes = peakRssBytes();
+  return r;
+}
+
+void printBench(std::ostream& out, const std::vector<BenchResult>& results,
+                const std::vector<FlowBenchResult>& flow,
+                const std::vector<RenderBenchResult>& render, bool json,
                 const std::string& source) {
   if (json) {
     out << "{\n  \"scene\": \"peers standard (Hertz-Mindlin, 6 walls)\",\n  \"packing\": \""
@@ -193,28 +308,65 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results, bool
           << ", \"coordination_end\": " << r.coordination_end
           << ", \"wall_stress_start_Pa\": " << r.wall_stress_start
           << ", \"wall_stress_end_Pa\": " << r.wall_stress_end << ", \"rebuilds\": " << r.rebuilds
+          << ", \"bonds\": " << r.bonds << ", \"peak_rss_bytes\": " << r.peak_rss_bytes
           << ", \"state_hash\": \"" << std::hex << r.state_hash << std::dec << "\"}"
           << (k + 1 < results.size() ? "," : "") << "\n";
     }
-    out << "  ]\n}\n";
+    out << "  ]";
+    for (const FlowBenchResult& f : flow) {
+      out << ",\n  \"flow\": {\"particles\": " << f.particles << ", \"pores\": " << f.pores
+          << ", \"pipes\": " << f.pipes << ", \"clusters\": " << f.clusters
+          << ", \"first_network_seconds\": " << f.first_network_seconds
+          << ", \"first_solve_seconds\": " << f.first_solve_seconds
+          << ", \"repeat_network_seconds\": " << f.repeat_network_seconds
+          << ", \"repeat_solve_seconds\": " << f.repeat_solve_seconds
+          << ", \"permeability_m2\": " << f.permeability
+          << ", \"kozeny_carman_m2\": " << f.kozeny_carman
+          << ", \"peak_rss_bytes\": " << f.peak_rss_bytes << "}";
+    }
+    for (const RenderBenchResult& g : render) {
+      out << ",\n  \"render\": {\"particles\": " << g.particles
+          << ", \"view_seconds\": " << g.view_seconds << ", \"slice_seconds\": " << g.slice_seconds
+          << ", \"peak_rss_bytes\": " << g.peak_rss_bytes << "}";
+    }
+    out << "\n}\n";
     return;
   }
-  out << "rocklab bench: " << source << ", Hertz-Mindlin, dt = " << kTimeStep << " s\n";
-  out << std::left << std::setw(8) << "threads" << std::setw(10) << "N" << std::setw(8) << "steps"
-      << std::setw(11) << "seconds" << std::setw(20) << "particle-steps/s" << std::setw(9)
-      << "Z start" << std::setw(7) << "Z end" << std::setw(20) << "wall stress (MPa)"
-      << std::setw(10) << "rebuilds"
-      << "state hash\n";
+  if (!results.empty()) {
+    out << "rocklab bench: " << source << ", Hertz-Mindlin"
+        << (results.front().bonds > 0 ? " + parallel bonds" : "") << ", dt = " << kTimeStep
+        << " s\n";
+    out << std::left << std::setw(8) << "threads" << std::setw(10) << "N" << std::setw(8) << "steps"
+        << std::setw(11) << "seconds" << std::setw(20) << "particle-steps/s" << std::setw(9)
+        << "Z start" << std::setw(7) << "Z end" << std::setw(20) << "wall stress (MPa)"
+        << std::setw(10) << "rebuilds" << std::setw(13) << "peak RSS/N"
+        << "state hash\n";
+  }
   for (const BenchResult& r : results) {
-    std::ostringstream stress;
+    std::ostringstream stress, rss;
     stress << std::fixed << std::setprecision(3) << r.wall_stress_start / 1e6 << " -> "
            << r.wall_stress_end / 1e6;
+    rss << std::fixed << std::setprecision(0) << r.peak_rss_bytes / static_cast<double>(r.particles)
+        << " B";
     out << std::left << std::setw(8) << r.threads << std::setw(10) << r.particles << std::setw(8)
         << r.steps << std::setw(11) << std::fixed << std::setprecision(3) << r.seconds
         << std::setw(20) << std::scientific << std::setprecision(3) << r.particle_steps_per_second
         << std::fixed << std::setprecision(3) << std::setw(9) << r.coordination_start
         << std::setw(7) << r.coordination_end << std::setw(20) << stress.str() << std::setw(10)
-        << r.rebuilds << std::hex << r.state_hash << std::dec << "\n";
+        << r.rebuilds << std::setw(13) << rss.str() << std::hex << r.state_hash << std::dec << "\n";
+  }
+  for (const FlowBenchResult& f : flow) {
+    out << std::defaultfloat << std::setprecision(4) << "pore network on " << f.particles
+        << " spheres: " << f.pores << " pores, " << f.pipes << " pipes, " << f.clusters
+        << " clusters after merging\n  first call: triangulation + network "
+        << f.first_network_seconds << " s, solve " << f.first_solve_seconds
+        << " s\n  repeat call: network " << f.repeat_network_seconds << " s, solve "
+        << f.repeat_solve_seconds << " s\n  k = " << f.permeability << " m^2, Kozeny-Carman (180) "
+        << f.kozeny_carman << " m^2, ratio " << f.permeability / f.kozeny_carman << "\n";
+  }
+  for (const RenderBenchResult& g : render) {
+    out << std::defaultfloat << std::setprecision(4) << "snapshot of " << g.particles
+        << " spheres: cutaway view " << g.view_seconds << " s, slice " << g.slice_seconds << " s\n";
   }
 }
 

@@ -3,6 +3,7 @@
 // a dense packing of spheres in a box of six frictionless walls moving inward, Hertz-
 // Mindlin contacts, a fixed time step, 100 untimed and 2000 timed steps.
 
+#include <array>
 #include <cstdint>
 #include <iosfwd>
 #include <string>
@@ -18,10 +19,14 @@ struct BenchOptions {
   std::uint64_t steps = 2000;  // timed steps
   std::uint64_t warmup = 100;  // untimed steps first
   std::vector<int> threads{1};
-  double skin = 0.2e-3;      // m, the Verlet skin LIGGGHTS ran with
-  std::uint64_t seed = 1;    // for a generated packing
-  bool energy = false;       // track contact dissipation (LIGGGHTS does not)
-  std::string save_packing;  // write the generated packing here
+  double skin = 0.2e-3;              // m, the Verlet skin LIGGGHTS ran with
+  std::uint64_t seed = 1;            // for a generated packing
+  bool energy = false;               // track contact dissipation (LIGGGHTS does not)
+  std::string save_packing;          // write the generated packing here
+  std::array<int, 3> tile{1, 1, 1};  // copies of the packing along x, y, z (a larger scene)
+  bool bonded = false;               // a parallel bond on every initial contact (cemented rock)
+  bool flow = false;                 // also time the pore network and a steady solve on the packing
+  bool render = false;               // also time an off-screen snapshot of the packing
 };
 
 struct BenchResult {
@@ -35,7 +40,28 @@ struct BenchResult {
   double wall_stress_start = 0.0;  // Pa, mean of the six walls
   double wall_stress_end = 0.0;
   std::uint64_t rebuilds = 0;  // neighbour list rebuilds in the timed phase
+  std::uint64_t bonds = 0;     // bonded variant: bonds installed (none break: see bench.cpp)
   std::uint64_t state_hash = 0;
+  double peak_rss_bytes = 0.0;  // of the process so far (getrusage)
+};
+
+// The pore network on the packing (Yade's FlowEngine figures in ../shared/peers): the first
+// call triangulates, measures the network and solves; the repeat call, on the same
+// positions, measures and solves again.
+struct FlowBenchResult {
+  std::size_t particles = 0, pores = 0, pipes = 0, clusters = 0;
+  double first_network_seconds = 0.0, first_solve_seconds = 0.0;
+  double repeat_network_seconds = 0.0, repeat_solve_seconds = 0.0;
+  double permeability = 0.0;   // m^2
+  double kozeny_carman = 0.0;  // m^2, for the same porosity and mean diameter (constant 180)
+  double peak_rss_bytes = 0.0;
+};
+
+// An off-screen snapshot of the packing (the cutaway view and the slice of a report).
+struct RenderBenchResult {
+  std::size_t particles = 0;
+  double view_seconds = 0.0, slice_seconds = 0.0;
+  double peak_rss_bytes = 0.0;
 };
 
 // The generated stand-in for the peers' packings: radii uniform in [0.9, 1.1] mm, grown to
@@ -43,9 +69,21 @@ struct BenchResult {
 // packings were prepared.
 Packing<3> benchPacking(std::size_t n, std::uint64_t seed, int threads);
 
-BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int threads);
+// The packing repeated tile[0] x tile[1] x tile[2] times in a box as many times larger: a
+// scene of any size with the same local structure. Every other copy is mirrored along each
+// axis, so two copies meet face to face with the same layer of particles that touched the
+// wall there (plain copies would meet misaligned: fewer contacts, and a jolt).
+Packing<3> tilePacking(const Packing<3>& packing, const std::array<int, 3>& tile);
 
-void printBench(std::ostream& out, const std::vector<BenchResult>& results, bool json,
-                const std::string& source);
+BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int threads);
+FlowBenchResult runFlowBench(const Packing<3>& packing);
+RenderBenchResult runRenderBench(const Packing<3>& packing, const std::string& folder);
+
+// Peak resident memory of this process so far (bytes).
+double peakRssBytes();
+
+void printBench(std::ostream& out, const std::vector<BenchResult>& results,
+                const std::vector<FlowBenchResult>& flow,
+                const std::vector<RenderBenchResult>& render, bool json, const std::string& source);
 
 }  // namespace rocklab

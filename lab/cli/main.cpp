@@ -44,9 +44,20 @@ int runBenchCommand(rocklab::BenchOptions o, bool json) {
                           std::to_string(o.seed));
     }
   }
+  if (o.tile != std::array<int, 3>{1, 1, 1}) {
+    packing = tilePacking(packing, o.tile);
+    source += " tiled " + std::to_string(o.tile[0]) + "x" + std::to_string(o.tile[1]) + "x" +
+              std::to_string(o.tile[2]);
+  }
   std::vector<BenchResult> results;
-  for (int t : o.threads) results.push_back(runBench(packing, o, t));
-  printBench(std::cout, results, json, source);
+  std::vector<FlowBenchResult> flow;
+  std::vector<RenderBenchResult> render;
+  if (o.flow) flow.push_back(runFlowBench(packing));
+  if (o.render) render.push_back(runRenderBench(packing, "."));
+  if (!o.flow && !o.render) {
+    for (int t : o.threads) results.push_back(runBench(packing, o, t));
+  }
+  printBench(std::cout, results, flow, render, json, source);
   return 0;
 }
 
@@ -133,6 +144,14 @@ int main(int argc, char** argv) {
   b->add_option("--seed", bench.seed, "Seed of the generated packing");
   b->add_flag("--energy", bench.energy, "Track contact dissipation (the peers do not)");
   b->add_option("--save-packing", bench.save_packing, "Write the generated packing to this file");
+  b->add_option("--tile", bench.tile, "Copies of the packing along x,y,z, e.g. 5,5,4")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1000));
+  b->add_flag("--bonded", bench.bonded, "A parallel bond on every initial contact");
+  b->add_flag("--flow", bench.flow,
+              "Time the pore network (triangulation, network, steady solve) instead");
+  b->add_flag("--render", bench.render,
+              "Time an off-screen snapshot (bench-view.png, bench-slice.png here) instead");
   b->add_flag("--json", json, "Print JSON");
   b->callback([&] { action = [&] { return runBenchCommand(bench, json); }; });
 

@@ -92,8 +92,10 @@ inline void followContactFrame(Vec<D>& v, const Vec<D>& n, double spin_n, double
 // and capped at mu * Fn (Coulomb). When sliding, the shear dashpot is inactive so that
 // |Ft| <= mu Fn holds exactly.
 template <int D, class Law, bool kTrackEnergy>
-inline ContactResult<D> contactForce(const typename Law::Params& p, const ContactKinematics<D>& k,
-                                     Vec<D>& fs, double dt, ContactDissipation& diss) {
+[[gnu::always_inline]] inline ContactResult<D> contactForce(const typename Law::Params& p,
+                                                            const ContactKinematics<D>& k,
+                                                            Vec<D>& fs, double dt,
+                                                            ContactDissipation& diss) {
   const LawState s = Law::evaluate(p, k.overlap, k.shape, k.mstar);
   const Vec<D>& n = k.n;
   const double vn = k.vc.dot(n);
@@ -105,7 +107,10 @@ inline ContactResult<D> contactForce(const typename Law::Params& p, const Contac
   const Vec<D> fs_rotated = fs;
   fs -= (s.ks * dt) * vt;
 
+  // Each total receives one term per contact (its dissipation alone), so a contact's
+  // share can be kept and added later in the serial order with the same bits.
   Vec<D> ft;
+  double viscous = 0.0;
   const double limit = p.mu * std::max(s.fn_elastic, 0.0);
   const double fs2 = fs.squaredNorm();
   if (fs2 > limit * limit) {
@@ -119,9 +124,9 @@ inline ContactResult<D> contactForce(const typename Law::Params& p, const Contac
     }
   } else {
     ft = fs - s.cs * vt;
-    if constexpr (kTrackEnergy) diss.viscous += s.cs * vt.squaredNorm() * dt;
+    if constexpr (kTrackEnergy) viscous = s.cs * vt.squaredNorm() * dt;
   }
-  if constexpr (kTrackEnergy) diss.viscous += s.cn * vn * vn * dt;
+  if constexpr (kTrackEnergy) diss.viscous += viscous + s.cn * vn * vn * dt;
 
   ContactResult<D> r;
   r.force = fn * n + ft;

@@ -26,7 +26,7 @@ struct ContactPass {
   ContactStore<D>& contacts;
   std::vector<Wall<D>>& walls;
   double dt;
-  bool threaded;  // store per-pair results and gather, instead of scattering
+  bool threaded;  // split the particles among `threads` (same bits as one thread)
   int threads;
   bool track_energy;
   double overlap_limit;  // overlap / smaller radius beyond which the guard trips
@@ -38,14 +38,39 @@ struct ContactPass {
   bool overlap_exceeded = false;
 };
 
-// Per-pair results of the threaded pass, gathered per particle afterwards.
+// One pair's or wall contact's result, kept where another thread or a later serial sum
+// must apply it in the serial order. `diss` holds what the contact alone dissipated, so
+// adding it to a running total gives the same bits as the serial accumulation.
+// One pair's force on j and torques (lever arm times n x F_t) on i and on j.
+template <int D>
+struct PairForce {
+  Vec<D> force;
+  Ang<D> torque_i, torque_j;
+};
+
+// A contact's result kept where another thread or a later serial sum must apply it in the
+// serial order. `diss` holds what the contact alone dissipated, so adding it to a running
+// total gives the same bits as the serial accumulation.
+template <int D>
+struct KeptContact {
+  PairForce<D> f;
+  ContactDissipation diss;
+  double kn = 0.0, cn = 0.0;  // wall contacts: what the wall's servo gain reads
+  bool touching = false;
+};
+
+// Work space of the force loops, kept between steps to avoid reallocating.
 template <int D>
 struct PairBuffers {
-  std::vector<std::uint8_t> touching;
-  std::vector<Vec<D>> force;
-  std::vector<Ang<D>> torque_i, torque_j;
+  std::vector<std::size_t> range;                     // rows of each thread: [range[t], range[t+1])
+  std::vector<std::vector<std::uint32_t>> own_cross;  // per thread, its rows' cross pairs
+  std::vector<std::vector<std::uint32_t>> own_cross_row;
+  std::vector<std::uint32_t> cross, cross_row;  // all cross pairs (ascending) and their rows
+  std::vector<std::size_t> cross_start;         // where each thread's cross pairs start in `cross`
+  std::vector<KeptContact<D>> cross_result, wall_result;
+  std::vector<std::size_t> wall_split;
   std::vector<double> block_friction, block_viscous;
-  std::vector<std::uint8_t> block_over;
+  std::vector<std::uint8_t> block_over, thread_over;
 };
 
 template <int D>

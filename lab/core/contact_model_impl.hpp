@@ -3,10 +3,16 @@
 // files (contact_law_*.cpp), which instantiate them once per dimension.
 //
 // Determinism: the serial pass scatters each pair's force to both particles in pair
-// order. The threaded pass computes the same per-pair results into buffers and each
-// particle then sums them in the same pair order (first the pairs where it is the partner,
-// which belong to lower rows, then its own row), so both give identical bits.
+// order. The threaded pass gives each thread a run of whole blocks of rows and the same
+// order: a thread scatters directly within its rows; a pair reaching past its last row (a
+// "cross" pair, near the boundary between runs) is computed first into a buffer, its
+// partner's share added by the partner's thread before anything else (those pairs belong
+// to lower rows, so they come first in pair order) and its own share in its place in the
+// row. Pairs have j > i and rows list partners ascending (neighbors.cpp).
 
+#include <omp.h>
+
+#include <algorithm>
 #include <cmath>
 
 #include "lab/core/contact_model.hpp"
@@ -24,10 +30,9 @@ class ContactModelImpl final : public ContactModel<D> {
 
   void computeForces(ContactPass<D>& pass) override {
     if (pass.threaded) {
-      pass.track_energy ? pairLoop<true, true>(pass) : pairLoop<false, true>(pass);
-      gather(pass);
+      pass.track_energy ? threadedPairLoop<true>(pass) : threadedPairLoop<false>(pass);
     } else {
-      pass.track_energy ? pairLoop<true, false>(pass) : pairLoop<false, false>(pass);
+      pass.track_energy ? serialPairLoop<true>(pass) : serialPairLoop<false>(pass);
     }
     pass.track_energy ? wallLoop<true>(pass) : wallLoop<false>(pass);
   }
@@ -55,101 +60,85 @@ class ContactModelImpl final : public ContactModel<D> {
   }
 
  private:
-  template <bool kEnergy, bool kThreaded>
-  void pairLoop(ContactPass<D>& pass) {
-    using V = Vec<D>;
-    using A = Ang<D>;
-    auto& P = pass.particles;
+  using V = Vec<D>;
+  using A = Ang<D>;
+
+  // What the pair loops read, as plain pointers (hoisted out of the loops).
+  struct PairView {
+    const V* pos;
+    const V* vel;
+    const A* spin;
+    const double* radius;
+    const double* inv_mass;
+    const std::uint16_t* material;
+    const std::uint32_t* col;
+    V* shear;
+    double dt, thickness, overlap_limit;
+  };
+
+  static PairView viewOf(ContactPass<D>& pass) {
+    const auto& P = pass.particles;
     auto& C = pass.contacts;
-    const std::size_t n = P.size();
-    const std::size_t blocks = (n + kBlockRows - 1) / kBlockRows;
-    const V* pos = P.pos.data();
-    const V* vel = P.vel.data();
-    const A* spin = P.spin.data();
-    const double* rad = P.radius.data();
-    const double* im = P.inv_mass.data();
-    const std::uint16_t* mat = P.material.data();
-    V* force = P.force.data();
-    A* torque = P.torque.data();
-    const std::uint32_t* row = C.pairs.row.data();
-    const std::uint32_t* col = C.pairs.col.data();
-    V* shear = C.shear.data();
-    const double dt = pass.dt;
-    const double thickness = P.thickness;
-    const double limit = pass.overlap_limit;
+    return {P.pos.data(),      P.vel.data(),      P.spin.data(),      P.radius.data(),
+            P.inv_mass.data(), P.material.data(), C.pairs.col.data(), C.shear.data(),
+            pass.dt,           P.thickness,       pass.overlap_limit};
+  }
 
-    auto& B = buffers_;
-    B.block_friction.assign(blocks, 0.0);
-    B.block_viscous.assign(blocks, 0.0);
-    B.block_over.assign(blocks, 0);
-    if constexpr (kThreaded) {
-      const std::size_t np = C.pairs.pairs();
-      B.touching.resize(np);
-      B.force.resize(np);
-      B.torque_i.resize(np);
-      B.torque_j.resize(np);
-    }
+  // Particle i of a row, read once for all its pairs (the force stores could alias the
+  // arrays, so the compiler would read them again for every pair).
+  struct RowParticle {
+    V x, v;
+    A w;
+    double r, inv_mass;
+    std::uint16_t material;
+  };
 
-#pragma omp parallel for schedule(dynamic, 1) num_threads(pass.threads) if (kThreaded)
-    for (std::size_t b = 0; b < blocks; ++b) {
-      ContactDissipation diss;
-      std::uint8_t over = 0;
-      const std::size_t i_end = std::min(n, (b + 1) * kBlockRows);
-      for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
-        const V xi = pos[i];
-        const double ri = rad[i];
-        const V vi = vel[i];
-        const A wi = spin[i];
-        const double imi = im[i];
-        const std::uint16_t mi = mat[i];
-        for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-          const std::uint32_t j = col[p];
-          const V d = pos[j] - xi;
-          const double dist2 = d.squaredNorm();
-          const double rj = rad[j];
-          const double reach = ri + rj;
-          if (dist2 >= reach * reach) {
-            shear[p].setZero();
-            if constexpr (kThreaded) B.touching[p] = 0;
-            continue;
-          }
-          const double dist = std::sqrt(dist2);
-          ContactKinematics<D> k;
-          k.n = d / dist;
-          k.overlap = reach - dist;
-          const double li = ri - 0.5 * k.overlap, lj = rj - 0.5 * k.overlap;
-          const A wj = spin[j];
-          // Velocity of j's contact point relative to i's: v_j - v_i - (lj wj + li wi) x n.
-          k.vc = vel[j] - vi - cross(A(lj * wj + li * wi), k.n);
-          if constexpr (D == 3) {
-            k.spin_n = 0.5 * spinAbout(A(wi + wj), k.n);
-          } else {
-            k.spin_n = 0.0;
-          }
-          k.shape = pairShape<D>(ri, rj, thickness);
-          const double imsum = imi + im[j];
-          k.mstar = imsum > 0.0 ? 1.0 / imsum : 0.0;
-          over |= static_cast<std::uint8_t>(k.overlap > limit * std::min(ri, rj));
-          const ContactResult<D> r =
-              contactForce<D, Law, kEnergy>(table_(mi, mat[j]), k, shear[p], dt, diss);
-          const A ti = li * r.n_cross_ft, tj = lj * r.n_cross_ft;
-          if constexpr (kThreaded) {
-            B.touching[p] = 1;
-            B.force[p] = r.force;
-            B.torque_i[p] = ti;
-            B.torque_j[p] = tj;
-          } else {
-            force[i] -= r.force;
-            force[j] += r.force;
-            torque[i] -= ti;
-            torque[j] -= tj;
-          }
-        }
-      }
-      B.block_friction[b] = diss.friction;
-      B.block_viscous[b] = diss.viscous;
-      B.block_over[b] = over;
+  static RowParticle rowParticle(const PairView& v, std::size_t i) {
+    return {v.pos[i], v.vel[i], v.spin[i], v.radius[i], v.inv_mass[i], v.material[i]};
+  }
+
+  // Pair p of row i: its force and torques into `out`; false (and the history cleared)
+  // when the pair does not touch.
+  template <bool kEnergy>
+  [[gnu::always_inline]] bool interact(const PairView& v, const RowParticle& a, std::uint32_t p,
+                                       PairForce<D>& out, ContactDissipation& diss,
+                                       std::uint8_t& over) const {
+    const std::uint32_t j = v.col[p];
+    const V d = v.pos[j] - a.x;
+    const double dist2 = d.squaredNorm();
+    const double ri = a.r, rj = v.radius[j];
+    const double reach = ri + rj;
+    if (dist2 >= reach * reach) {
+      v.shear[p].setZero();
+      return false;
     }
+    const double dist = std::sqrt(dist2);
+    ContactKinematics<D> k;
+    k.n = d / dist;
+    k.overlap = reach - dist;
+    const double li = ri - 0.5 * k.overlap, lj = rj - 0.5 * k.overlap;
+    const A wj = v.spin[j];
+    // Velocity of j's contact point relative to i's: v_j - v_i - (lj wj + li wi) x n.
+    k.vc = v.vel[j] - a.v - cross(A(lj * wj + li * a.w), k.n);
+    if constexpr (D == 3) {
+      k.spin_n = 0.5 * spinAbout(A(a.w + wj), k.n);
+    } else {
+      k.spin_n = 0.0;
+    }
+    k.shape = pairShape<D>(ri, rj, v.thickness);
+    const double imsum = a.inv_mass + v.inv_mass[j];
+    k.mstar = imsum > 0.0 ? 1.0 / imsum : 0.0;
+    over |= static_cast<std::uint8_t>(k.overlap > v.overlap_limit * std::min(ri, rj));
+    const ContactResult<D> r =
+        contactForce<D, Law, kEnergy>(table_(a.material, v.material[j]), k, v.shear[p], v.dt, diss);
+    out.force = r.force;
+    out.torque_i = li * r.n_cross_ft;
+    out.torque_j = lj * r.n_cross_ft;
+    return true;
+  }
+
+  void addBlockSums(ContactPass<D>& pass, std::size_t blocks) const {
+    const auto& B = buffers_;
     for (std::size_t b = 0; b < blocks; ++b) {
       pass.friction += B.block_friction[b];
       pass.viscous += B.block_viscous[b];
@@ -157,37 +146,235 @@ class ContactModelImpl final : public ContactModel<D> {
     }
   }
 
-  void gather(ContactPass<D>& pass) {
+  void resetBlockSums(std::size_t blocks) {
+    buffers_.block_friction.assign(blocks, 0.0);
+    buffers_.block_viscous.assign(blocks, 0.0);
+    buffers_.block_over.assign(blocks, 0);
+  }
+
+  template <bool kEnergy>
+  void serialPairLoop(ContactPass<D>& pass) {
     auto& P = pass.particles;
-    auto& C = pass.contacts;
-    const auto& B = buffers_;
+    const auto& row = pass.contacts.pairs.row;
+    const auto& col = pass.contacts.pairs.col;
     const std::size_t n = P.size();
-#pragma omp parallel for schedule(static) num_threads(pass.threads)
-    for (std::size_t k = 0; k < n; ++k) {
-      Vec<D> f = P.force[k];
-      Ang<D> t = P.torque[k];
-      for (std::uint32_t q = C.partner_row[k]; q < C.partner_row[k + 1]; ++q) {
-        const std::uint32_t p = C.partner_pair[q];
-        if (!B.touching[p]) continue;
-        f += B.force[p];
-        t -= B.torque_j[p];
+    const std::size_t blocks = (n + kBlockRows - 1) / kBlockRows;
+    resetBlockSums(blocks);
+    const PairView v = viewOf(pass);
+    V* force = P.force.data();
+    A* torque = P.torque.data();
+    PairForce<D> c;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      ContactDissipation diss;
+      std::uint8_t over = 0;
+      const std::size_t i_end = std::min(n, (b + 1) * kBlockRows);
+      for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
+        const RowParticle a = rowParticle(v, i);
+        for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+          if (!interact<kEnergy>(v, a, p, c, diss, over)) continue;
+          const std::uint32_t j = col[p];
+          force[i] -= c.force;
+          force[j] += c.force;
+          torque[i] -= c.torque_i;
+          torque[j] -= c.torque_j;
+        }
       }
-      for (std::uint32_t p = C.pairs.row[k]; p < C.pairs.row[k + 1]; ++p) {
-        if (!B.touching[p]) continue;
-        f -= B.force[p];
-        t -= B.torque_i[p];
-      }
-      P.force[k] = f;
-      P.torque[k] = t;
+      buffers_.block_friction[b] = diss.friction;
+      buffers_.block_viscous[b] = diss.viscous;
+      buffers_.block_over[b] = over;
+    }
+    addBlockSums(pass, blocks);
+  }
+
+  // Runs of whole blocks, one per thread, with about the same number of pairs each.
+  void splitRows(std::size_t n, std::size_t blocks, int threads,
+                 const std::vector<std::uint32_t>& row) {
+    auto& range = buffers_.range;
+    range.assign(threads + 1, n);
+    range[0] = 0;
+    const double pairs = row[n];
+    std::size_t b = 0;
+    for (int t = 1; t < threads; ++t) {
+      const double target = pairs * t / threads;
+      while (b < blocks && row[std::min(n, b * kBlockRows)] < target) ++b;
+      range[t] = std::min(n, b * kBlockRows);
     }
   }
 
-  // Particle-wall contacts, in list order on one thread: they are few (the sample's
-  // surface) and each wall's force sum must not depend on the thread count.
+  template <bool kEnergy>
+  void threadedPairLoop(ContactPass<D>& pass) {
+    auto& P = pass.particles;
+    const auto& C = pass.contacts;
+    const auto& row = C.pairs.row;
+    const auto& col = C.pairs.col;
+    const std::size_t n = P.size();
+    const std::size_t blocks = (n + kBlockRows - 1) / kBlockRows;
+    const int threads = pass.threads;
+    auto& B = buffers_;
+    resetBlockSums(blocks);
+    splitRows(n, blocks, threads, row);
+    B.own_cross.resize(threads);
+    B.own_cross_row.resize(threads);
+    B.cross_start.assign(threads + 1, 0);
+    B.thread_over.assign(threads, 0);
+    const PairView v = viewOf(pass);
+    V* force = P.force.data();
+    A* torque = P.torque.data();
+
+#pragma omp parallel num_threads(threads)
+    {
+      const int t = omp_get_thread_num();
+      const std::size_t lo = B.range[t], hi = B.range[t + 1];
+      // The cross pairs of this thread's rows: the tail of each row (partners ascend).
+      auto& own = B.own_cross[t];
+      auto& own_row = B.own_cross_row[t];
+      own.clear();
+      own_row.clear();
+      for (std::size_t i = lo; i < hi; ++i) {
+        std::uint32_t s = row[i + 1];
+        while (s > row[i] && col[s - 1] >= hi) --s;
+        for (std::uint32_t p = s; p < row[i + 1]; ++p) {
+          own.push_back(p);
+          own_row.push_back(static_cast<std::uint32_t>(i));
+        }
+      }
+#pragma omp barrier
+#pragma omp single
+      {
+        B.cross.clear();
+        B.cross_row.clear();
+        for (int u = 0; u < threads; ++u) {
+          B.cross_start[u] = B.cross.size();
+          B.cross.insert(B.cross.end(), B.own_cross[u].begin(), B.own_cross[u].end());
+          B.cross_row.insert(B.cross_row.end(), B.own_cross_row[u].begin(),
+                             B.own_cross_row[u].end());
+        }
+        B.cross_start[threads] = B.cross.size();
+        B.cross_result.resize(B.cross.size());
+      }
+      // The cross pairs first, shared out evenly (the runs' boundaries hold most of them).
+      std::uint8_t cross_over = 0;
+#pragma omp for schedule(static)
+      for (std::size_t g = 0; g < B.cross.size(); ++g) {
+        KeptContact<D>& c = B.cross_result[g];
+        c.diss = {};
+        const RowParticle a = rowParticle(v, B.cross_row[g]);
+        c.touching = interact<kEnergy>(v, a, B.cross[g], c.f, c.diss, cross_over);
+      }
+      B.thread_over[t] = cross_over;
+
+      // The partners' shares of lower threads' cross pairs come first ...
+      const std::uint32_t first_pair = row[lo];
+      for (std::size_t k = lo; k < hi; ++k) {
+        for (std::uint32_t q = C.partner_row[k]; q < C.partner_row[k + 1]; ++q) {
+          const std::uint32_t p = C.partner_pair[q];
+          if (p >= first_pair) break;
+          const auto g = std::lower_bound(B.cross.begin(), B.cross.end(), p) - B.cross.begin();
+          const KeptContact<D>& c = B.cross_result[g];
+          if (!c.touching) continue;
+          force[k] += c.f.force;
+          torque[k] -= c.f.torque_j;
+        }
+      }
+      // ... then the rows in order, as the serial pass.
+      std::size_t g = B.cross_start[t];
+      PairForce<D> c;
+      for (std::size_t b = lo / kBlockRows; b * kBlockRows < hi; ++b) {
+        ContactDissipation diss;
+        std::uint8_t over = 0;
+        const std::size_t i_end = std::min(hi, (b + 1) * kBlockRows);
+        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
+          const RowParticle a = rowParticle(v, i);
+          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+            const std::uint32_t j = col[p];
+            if (j >= hi) {
+              const KeptContact<D>& kept = B.cross_result[g++];
+              if (!kept.touching) continue;
+              if constexpr (kEnergy) {
+                diss.friction += kept.diss.friction;
+                diss.viscous += kept.diss.viscous;
+              }
+              force[i] -= kept.f.force;
+              torque[i] -= kept.f.torque_i;
+              continue;
+            }
+            if (!interact<kEnergy>(v, a, p, c, diss, over)) continue;
+            force[i] -= c.force;
+            force[j] += c.force;
+            torque[i] -= c.torque_i;
+            torque[j] -= c.torque_j;
+          }
+        }
+        B.block_friction[b] = diss.friction;
+        B.block_viscous[b] = diss.viscous;
+        B.block_over[b] = over;
+      }
+    }
+    addBlockSums(pass, blocks);
+    for (std::uint8_t over : B.thread_over) pass.overlap_exceeded |= over != 0;
+  }
+
+  // Particle-wall contacts. The list holds a particle's contacts together; each thread
+  // takes a run of whole particles and applies their forces in list order, and the walls'
+  // sums are then made in list order on one thread, so no total depends on the thread
+  // count.
   template <bool kEnergy>
   void wallLoop(ContactPass<D>& pass) {
     auto& P = pass.particles;
     auto& C = pass.contacts;
+    auto& B = buffers_;
+    const std::size_t m = C.wall_particle.size();
+    const int threads = pass.threaded ? pass.threads : 1;
+    B.wall_result.resize(m);
+    B.wall_split.assign(threads + 1, m);
+    B.wall_split[0] = 0;
+    for (int t = 1; t < threads; ++t) {
+      std::size_t c = std::max(B.wall_split[t - 1], m * t / threads);
+      while (c > 0 && c < m && C.wall_particle[c] == C.wall_particle[c - 1]) ++c;
+      B.wall_split[t] = c;
+    }
+    B.thread_over.assign(threads, 0);
+
+#pragma omp parallel num_threads(threads) if (threads > 1)
+    {
+      const int t = omp_get_thread_num();
+      std::uint8_t over = 0;
+      for (std::size_t c = B.wall_split[t]; c < B.wall_split[t + 1]; ++c) {
+        KeptContact<D>& kept = B.wall_result[c];
+        kept.diss = {};
+        const std::uint32_t i = C.wall_particle[c];
+        const Wall<D>& w = pass.walls[C.wall_index[c]];
+        const double ri = P.radius[i];
+        const double overlap = ri - w.distance(P.pos[i]);
+        kept.touching = overlap > 0.0;
+        if (!kept.touching) {
+          C.wall_shear[c].setZero();
+          continue;
+        }
+        ContactKinematics<D> k;
+        k.n = -w.normal;
+        k.overlap = overlap;
+        const double li = ri - overlap;  // the contact point lies on the rigid plane
+        k.vc = w.velocity - P.vel[i] - cross(A(li * P.spin[i]), k.n);
+        if constexpr (D == 3) {
+          k.spin_n = 0.5 * spinAbout(P.spin[i], k.n);
+        } else {
+          k.spin_n = 0.0;
+        }
+        k.shape = wallShape<D>(ri, P.thickness);
+        k.mstar = P.inv_mass[i] > 0.0 ? 1.0 / P.inv_mass[i] : 0.0;
+        over |= static_cast<std::uint8_t>(overlap > pass.overlap_limit * ri);
+        const ContactResult<D> r = contactForce<D, Law, kEnergy>(
+            table_(P.material[i], w.material), k, C.wall_shear[c], pass.dt, kept.diss);
+        P.force[i] -= r.force;
+        P.torque[i] -= li * r.n_cross_ft;
+        kept.f.force = r.force;
+        kept.kn = r.kn;
+        kept.cn = r.cn;
+      }
+      B.thread_over[t] = over;
+    }
+
     for (auto& w : pass.walls) {
       w.force.setZero();
       w.stiffness = 0.0;
@@ -195,37 +382,20 @@ class ContactModelImpl final : public ContactModel<D> {
       w.contacts = 0;
     }
     ContactDissipation diss;
-    for (std::size_t c = 0; c < C.wall_particle.size(); ++c) {
-      const std::uint32_t i = C.wall_particle[c];
+    for (std::size_t c = 0; c < m; ++c) {
+      const KeptContact<D>& kept = B.wall_result[c];
+      if (!kept.touching) continue;
       Wall<D>& w = pass.walls[C.wall_index[c]];
-      const double ri = P.radius[i];
-      const double overlap = ri - w.distance(P.pos[i]);
-      if (overlap <= 0.0) {
-        C.wall_shear[c].setZero();
-        continue;
-      }
-      ContactKinematics<D> k;
-      k.n = -w.normal;
-      k.overlap = overlap;
-      const double li = ri - overlap;  // the contact point lies on the rigid plane
-      k.vc = w.velocity - P.vel[i] - cross(Ang<D>(li * P.spin[i]), k.n);
-      if constexpr (D == 3) {
-        k.spin_n = 0.5 * spinAbout(P.spin[i], k.n);
-      } else {
-        k.spin_n = 0.0;
-      }
-      k.shape = wallShape<D>(ri, P.thickness);
-      k.mstar = P.inv_mass[i] > 0.0 ? 1.0 / P.inv_mass[i] : 0.0;
-      pass.overlap_exceeded |= overlap > pass.overlap_limit * ri;
-      const ContactResult<D> r = contactForce<D, Law, kEnergy>(table_(P.material[i], w.material), k,
-                                                               C.wall_shear[c], pass.dt, diss);
-      P.force[i] -= r.force;
-      P.torque[i] -= li * r.n_cross_ft;
-      w.force += r.force;
-      w.stiffness += r.kn;
-      w.damping += r.cn;
+      w.force += kept.f.force;
+      w.stiffness += kept.kn;
+      w.damping += kept.cn;
       ++w.contacts;
+      if constexpr (kEnergy) {
+        diss.friction += kept.diss.friction;
+        diss.viscous += kept.diss.viscous;
+      }
     }
+    for (std::uint8_t over : B.thread_over) pass.overlap_exceeded |= over != 0;
     pass.friction += diss.friction;
     pass.viscous += diss.viscous;
   }
