@@ -277,11 +277,19 @@ void renderView(const Frame& f, const FieldValues& field, const std::vector<Brea
     addScaleBar(sc.renderer, b.lo[0] * kMm, width, -0.02 * width, b.lo[1] * kMm - 0.06 * width);
     sc.look({c[0] * kMm, 0.0, c[1] * kMm}, {c[0] * kMm, -1e3, c[1] * kMm});
   } else {
-    // The half behind the mid-plane y = centre: its cut face shows the interior.
+    // The half behind the mid-plane y = centre: its cut face shows the interior. Only the
+    // particles within a few diameters of the faces the camera sees (the cut, x = min,
+    // z = max) are drawn: the rest are hidden behind them, and software GL spends its time
+    // on every triangle, seen or not (30,000 spheres: 3.6 s drawn all, 1.5 s culled).
+    double rmax = 0.0;
+    for (double r : f.radius) rmax = std::max(rmax, r);
+    const double depth = 6.0 * rmax;
     std::vector<std::array<double, 3>> centres;
     std::vector<double> radii, values;
     for (std::size_t i = 0; i < f.size(); ++i) {
-      if (f.pos[i][1] < c[1]) continue;
+      const auto& x = f.pos[i];
+      if (x[1] < c[1]) continue;
+      if (x[1] - c[1] > depth && x[0] - b.lo[0] > depth && b.hi[2] - x[2] > depth) continue;
       centres.push_back(f.pos[i]);
       radii.push_back(f.radius[i]);
       values.push_back(field.values[i]);

@@ -103,7 +103,7 @@ typename BondForces<D>::Kept BondForces<D>::evaluate(const BondPass<D>& pass,
   const auto section = BondSection<D>::of(B.radius[b], P.thickness);
   const BondResult<D> r = bondForce<D>(section, B.kn[b], B.ks[b], k, B.load[b], pass.dt);
   Kept out;
-  if (r.tensile >= B.tensile[b] || r.shear >= B.shear[b]) {
+  if (pass.breakable && (r.tensile >= B.tensile[b] || r.shear >= B.shear[b])) {
     const double rt = r.tensile / B.tensile[b], rs = r.shear / B.shear[b];
     const bool tensile = r.tensile >= B.tensile[b] && (r.shear < B.shear[b] || rt >= rs);
     out.broken = true;

@@ -20,6 +20,7 @@ struct BondPass {
   double dt;
   bool threaded;
   int threads;
+  bool breakable;  // false: no bond breaks, whatever its load
 
   // Out: the bonds that broke this step, by increasing index, with mode and stress.
   std::vector<std::uint32_t> broken;

@@ -333,7 +333,7 @@ template <int D>
 void Simulation<D>::computeBondForces(double dt) {
   const auto t0 = std::chrono::steady_clock::now();
   auto& P = particles_;
-  BondPass<D> pass{P, bonds_, dt, threaded(), config_.threads, {}, {}, {}};
+  BondPass<D> pass{P, bonds_, dt, threaded(), config_.threads, config_.bond_breakage, {}, {}, {}};
   bond_forces_.compute(pass);
   if (!pass.broken.empty()) {
     // Second phase: log and remove the broken bonds in bond order.
@@ -1070,6 +1070,7 @@ void Simulation<D>::visit(Archive& ar) {
   ar("config.guard.energy_runaway", config_.guard.energy_runaway);
   ar("config.threads", config_.threads), ar("config.track_energy", config_.track_energy);
   ar("config.spatial_sort", config_.spatial_sort), ar("config.gravity", config_.gravity);
+  ar("config.bond_breakage", config_.bond_breakage);
 
   std::vector<Material> mats = materials_.all();
   std::vector<OverrideRow> rows;

@@ -54,6 +54,9 @@ struct SimulationConfig {
   bool track_energy = true;  // friction and viscous dissipation, per contact
   bool spatial_sort = true;  // reorder particles along the cell grid on rebuilds
   std::array<double, 3> gravity{0.0, 0.0, 0.0};  // m/s^2, only the first D components used
+  // false: bonds carry any load unbroken (an ultrasonic window: microseconds in which the
+  // lab sample breaks nothing, while a DEM sample loaded fast keeps breaking for long).
+  bool bond_breakage = true;
 };
 
 // Energy exchanged since the ledger started (J).
@@ -152,6 +155,7 @@ class Simulation {
   void scaleRadii(double factor);
   void setThreads(int threads);
   void setLocalDamping(double alpha) { config_.local_damping = alpha; }
+  void setBondBreakage(bool on) { config_.bond_breakage = on; }
   void setFixedTimeStep(double dt);
   // Replaces the materials (e.g. the friction after forming a sample); contact history and
   // bonds stay. The table must keep the indices particles and walls use.
@@ -244,7 +248,8 @@ class Simulation {
   // --- checkpoints ---
   void saveCheckpoint(const std::string& path) const;
   static Simulation loadCheckpoint(const std::string& path);
-  static constexpr std::uint32_t kCheckpointVersion = 2;
+  // Version 3 added config.bond_breakage.
+  static constexpr std::uint32_t kCheckpointVersion = 3;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };

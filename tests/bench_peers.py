@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""rocklab beside LIGGGHTS on the peers' standard scene (../shared/peers/README.md).
+
+Not part of `make test`: timings are not assertions. Runs rocklab and LIGGGHTS alternately
+on the same packing, on one core and on two, at least three times each, and prints the
+medians and their ratios (the issue's targets: rocklab >= 1.5x LIGGGHTS on one core, and
+rocklab on two threads >= 1.8x its own one-core figure).
+
+usage: tests/bench_peers.py [--runs N] [--rocklab PATH] [--steps S] PACKING [PACKING ...]
+e.g.   tests/bench_peers.py ../shared/peers/packing_10k.txt ../shared/peers/packing_50k.txt
+
+LIGGGHTS comes from Debian. It is installed here without its recommended packages: ParaView
+conflicts with python3-vtk9, which libvtk9-dev (rocklab's VTK) needs.
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+PEERS = os.path.normpath(os.path.join(ROOT, "..", "shared", "peers"))
+LOOP = re.compile(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
+
+
+def ensure_liggghts():
+    if shutil.which("liggghts"):
+        return
+    sudo = [] if os.geteuid() == 0 else ["sudo"]
+    print("installing liggghts (Debian, without recommends) ...", file=sys.stderr)
+    subprocess.run(sudo + ["apt-get", "install", "-y", "-q", "--no-install-recommends",
+                           "liggghts", "openmpi-bin"], check=True)
+
+
+def rocklab_rate(rocklab, packing, threads, steps):
+    out = subprocess.run([rocklab, "bench", "--packing", packing, "--threads", str(threads),
+                          "--steps", str(steps), "--json"],
+                         check=True, capture_output=True, text=True).stdout
+    run = json.loads(out)["runs"][0]
+    return run["particle_steps_per_second"], run["state_hash"]
+
+
+def liggghts_rate(lig_dir, procs, steps):
+    cmd = ["liggghts", "-in", os.path.join(PEERS, "in.bench"), "-var", "dir", lig_dir,
+           "-var", "steps", str(steps), "-var", "warm", "100", "-var", "skin", "0.0002",
+           "-log", "none"]
+    if procs > 1:
+        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(procs)] + cmd
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True,
+                         env=dict(os.environ, OMP_NUM_THREADS="1")).stdout
+    loops = LOOP.findall(out)
+    if not loops:
+        raise RuntimeError("no 'Loop time' line in LIGGGHTS' output:\n" + out[-2000:])
+    seconds, _, nsteps, atoms = loops[-1]
+    return int(atoms) * int(nsteps) / float(seconds)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("packings", nargs="+")
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--steps", type=int, default=2000)
+    ap.add_argument("--rocklab", default=os.path.join(ROOT, "build", "release", "rocklab"))
+    a = ap.parse_args()
+    if a.runs < 3:
+        sys.exit("--runs: at least 3 (medians of fewer say little on a shared machine)")
+    if not os.access(a.rocklab, os.X_OK):
+        sys.exit(a.rocklab + ": build rocklab first (make build)")
+    ensure_liggghts()
+    rows = []
+    for packing in a.packings:
+        with tempfile.TemporaryDirectory() as tmp:
+            lig_dir = os.path.join(tmp, "lig")
+            subprocess.run([sys.executable, os.path.join(PEERS, "make_liggghts_input.py"),
+                            packing, lig_dir], check=True, capture_output=True)
+            r1, r2, l1, l2, hashes = [], [], [], [], set()
+            for k in range(a.runs):
+                # Alternate the codes so a slow spell of the machine hits both.
+                l1.append(liggghts_rate(lig_dir, 1, a.steps))
+                rate, h = rocklab_rate(a.rocklab, packing, 1, a.steps)
+                r1.append(rate)
+                hashes.add(h)
+                l2.append(liggghts_rate(lig_dir, 2, a.steps))
+                rate, h = rocklab_rate(a.rocklab, packing, 2, a.steps)
+                r2.append(rate)
+                hashes.add(h)
+                print(f"{os.path.basename(packing)} run {k + 1}: LIGGGHTS {l1[-1]:.3e} / "
+                      f"{l2[-1]:.3e}, rocklab {r1[-1]:.3e} / {r2[-1]:.3e} (1 / 2 cores)",
+                      file=sys.stderr)
+            med = {n: statistics.median(v) for n, v in
+                   (("l1", l1), ("l2", l2), ("r1", r1), ("r2", r2))}
+            rows.append((os.path.basename(packing), med, len(hashes) == 1))
+    print(f"medians of {a.runs} alternating runs, particle-steps/s ({a.steps} timed steps)")
+    print(f"{'packing':<18}{'LIGGGHTS 1':>12}{'rocklab 1':>12}{'ratio':>7}"
+          f"{'LIGGGHTS 2':>12}{'rocklab 2':>12}{'ratio':>7}{'rocklab 2/1':>13}  same hash")
+    for name, m, same in rows:
+        print(f"{name:<18}{m['l1']:>12.3e}{m['r1']:>12.3e}{m['r1'] / m['l1']:>7.2f}"
+              f"{m['l2']:>12.3e}{m['r2']:>12.3e}{m['r2'] / m['l2']:>7.2f}"
+              f"{m['r2'] / m['r1']:>13.2f}  {'yes' if same else 'NO'}")
+
+
+if __name__ == "__main__":
+    main()
