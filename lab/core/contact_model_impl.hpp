@@ -97,12 +97,11 @@ class ContactModelImpl final : public ContactModel<D> {
     return {v.pos[i], v.vel[i], v.spin[i], v.radius[i], v.inv_mass[i], v.material[i]};
   }
 
-  // Pair p of row i: its force and torques into `out`; false (and the history cleared)
-  // when the pair does not touch.
-  template <bool kEnergy>
+  // Pair p of row i: hands j, its force on j and its torques on i and j to `apply`; false (and
+  // the history cleared) when the pair does not touch.
+  template <bool kEnergy, class Apply>
   [[gnu::always_inline]] bool interact(const PairView& v, const RowParticle& a, std::uint32_t p,
-                                       PairForce<D>& out, ContactDissipation& diss,
-                                       std::uint8_t& over) const {
+                                       ContactDissipation& diss, bool& over, Apply&& apply) const {
     const std::uint32_t j = v.col[p];
     const V d = v.pos[j] - a.x;
     const double dist2 = d.squaredNorm();
@@ -128,12 +127,11 @@ class ContactModelImpl final : public ContactModel<D> {
     k.shape = pairShape<D>(ri, rj, v.thickness);
     const double imsum = a.inv_mass + v.inv_mass[j];
     k.mstar = imsum > 0.0 ? 1.0 / imsum : 0.0;
-    over |= static_cast<std::uint8_t>(k.overlap > v.overlap_limit * std::min(ri, rj));
+    over |= k.overlap > v.overlap_limit * std::min(ri, rj);
     const ContactResult<D> r =
         contactForce<D, Law, kEnergy>(table_(a.material, v.material[j]), k, v.shear[p], v.dt, diss);
-    out.force = r.force;
-    out.torque_i = li * r.n_cross_ft;
-    out.torque_j = lj * r.n_cross_ft;
+    const A ti = li * r.n_cross_ft, tj = lj * r.n_cross_ft;
+    apply(j, r.force, ti, tj);
     return true;
   }
 
@@ -155,28 +153,27 @@ class ContactModelImpl final : public ContactModel<D> {
   template <bool kEnergy>
   void serialPairLoop(ContactPass<D>& pass) {
     auto& P = pass.particles;
-    const auto& row = pass.contacts.pairs.row;
-    const auto& col = pass.contacts.pairs.col;
+    const std::uint32_t* row = pass.contacts.pairs.row.data();
     const std::size_t n = P.size();
     const std::size_t blocks = (n + kBlockRows - 1) / kBlockRows;
     resetBlockSums(blocks);
     const PairView v = viewOf(pass);
     V* force = P.force.data();
     A* torque = P.torque.data();
-    PairForce<D> c;
     for (std::size_t b = 0; b < blocks; ++b) {
       ContactDissipation diss;
-      std::uint8_t over = 0;
+      bool over = false;  // not a uint8_t: a char store may alias anything
       const std::size_t i_end = std::min(n, (b + 1) * kBlockRows);
       for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
         const RowParticle a = rowParticle(v, i);
         for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-          if (!interact<kEnergy>(v, a, p, c, diss, over)) continue;
-          const std::uint32_t j = col[p];
-          force[i] -= c.force;
-          force[j] += c.force;
-          torque[i] -= c.torque_i;
-          torque[j] -= c.torque_j;
+          interact<kEnergy>(v, a, p, diss, over,
+                            [&](std::uint32_t j, const V& f, const A& ti, const A& tj) {
+                              force[i] -= f;
+                              force[j] += f;
+                              torque[i] -= ti;
+                              torque[j] -= tj;
+                            });
         }
       }
       buffers_.block_friction[b] = diss.friction;
@@ -187,8 +184,7 @@ class ContactModelImpl final : public ContactModel<D> {
   }
 
   // Runs of whole blocks, one per thread, with about the same number of pairs each.
-  void splitRows(std::size_t n, std::size_t blocks, int threads,
-                 const std::vector<std::uint32_t>& row) {
+  void splitRows(std::size_t n, std::size_t blocks, int threads, const std::uint32_t* row) {
     auto& range = buffers_.range;
     range.assign(threads + 1, n);
     range[0] = 0;
@@ -205,8 +201,8 @@ class ContactModelImpl final : public ContactModel<D> {
   void threadedPairLoop(ContactPass<D>& pass) {
     auto& P = pass.particles;
     const auto& C = pass.contacts;
-    const auto& row = C.pairs.row;
-    const auto& col = C.pairs.col;
+    const std::uint32_t* row = C.pairs.row.data();
+    const std::uint32_t* col = C.pairs.col.data();
     const std::size_t n = P.size();
     const std::size_t blocks = (n + kBlockRows - 1) / kBlockRows;
     const int threads = pass.threads;
@@ -253,13 +249,18 @@ class ContactModelImpl final : public ContactModel<D> {
         B.cross_result.resize(B.cross.size());
       }
       // The cross pairs first, shared out evenly (the runs' boundaries hold most of them).
-      std::uint8_t cross_over = 0;
+      bool cross_over = false;
 #pragma omp for schedule(static)
       for (std::size_t g = 0; g < B.cross.size(); ++g) {
         KeptContact<D>& c = B.cross_result[g];
         c.diss = {};
         const RowParticle a = rowParticle(v, B.cross_row[g]);
-        c.touching = interact<kEnergy>(v, a, B.cross[g], c.f, c.diss, cross_over);
+        c.touching = interact<kEnergy>(v, a, B.cross[g], c.diss, cross_over,
+                                       [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
+                                         c.f.force = f;
+                                         c.f.torque_i = ti;
+                                         c.f.torque_j = tj;
+                                       });
       }
       B.thread_over[t] = cross_over;
 
@@ -278,10 +279,9 @@ class ContactModelImpl final : public ContactModel<D> {
       }
       // ... then the rows in order, as the serial pass.
       std::size_t g = B.cross_start[t];
-      PairForce<D> c;
       for (std::size_t b = lo / kBlockRows; b * kBlockRows < hi; ++b) {
         ContactDissipation diss;
-        std::uint8_t over = 0;
+        bool over = false;
         const std::size_t i_end = std::min(hi, (b + 1) * kBlockRows);
         for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
           const RowParticle a = rowParticle(v, i);
@@ -298,11 +298,13 @@ class ContactModelImpl final : public ContactModel<D> {
               torque[i] -= kept.f.torque_i;
               continue;
             }
-            if (!interact<kEnergy>(v, a, p, c, diss, over)) continue;
-            force[i] -= c.force;
-            force[j] += c.force;
-            torque[i] -= c.torque_i;
-            torque[j] -= c.torque_j;
+            interact<kEnergy>(v, a, p, diss, over,
+                              [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
+                                force[i] -= f;
+                                force[j] += f;
+                                torque[i] -= ti;
+                                torque[j] -= tj;
+                              });
           }
         }
         B.block_friction[b] = diss.friction;
