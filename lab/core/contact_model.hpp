@@ -69,7 +69,8 @@ struct PairBuffers {
   std::vector<std::size_t> cross_start;         // where each thread's cross pairs start in `cross`
   std::vector<KeptContact<D>> cross_result, wall_result;
   std::vector<std::size_t> wall_split;
-  std::vector<double> block_friction, block_viscous;
+  std::vector<double> block_friction, block_viscous, block_cost;
+  std::vector<std::uint32_t> block_touching;  // touching pairs per block, last threaded step
   std::vector<std::uint8_t> block_over, thread_over;
 };
 
