@@ -230,6 +230,7 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
   r.coordination_end = sim.coordinationNumber();
   r.wall_stress_end = meanWallStress(sim);
   r.rebuilds = sim.contacts().rebuilds - rebuilds;
+  r.listed_pairs = sim.contacts().pairs.pairs();
   r.state_hash = sim.stateHash();
   r.peak_rss_bytes = peakRssBytes();
   return r;
@@ -308,9 +309,9 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
           << ", \"coordination_end\": " << r.coordination_end
           << ", \"wall_stress_start_Pa\": " << r.wall_stress_start
           << ", \"wall_stress_end_Pa\": " << r.wall_stress_end << ", \"rebuilds\": " << r.rebuilds
-          << ", \"bonds\": " << r.bonds << ", \"peak_rss_bytes\": " << r.peak_rss_bytes
-          << ", \"state_hash\": \"" << std::hex << r.state_hash << std::dec << "\"}"
-          << (k + 1 < results.size() ? "," : "") << "\n";
+          << ", \"listed_pairs\": " << r.listed_pairs << ", \"bonds\": " << r.bonds
+          << ", \"peak_rss_bytes\": " << r.peak_rss_bytes << ", \"state_hash\": \"" << std::hex
+          << r.state_hash << std::dec << "\"}" << (k + 1 < results.size() ? "," : "") << "\n";
     }
     out << "  ]";
     for (const FlowBenchResult& f : flow) {

@@ -40,6 +40,7 @@ struct BenchResult {
   double wall_stress_start = 0.0;  // Pa, mean of the six walls
   double wall_stress_end = 0.0;
   std::uint64_t rebuilds = 0;  // neighbour list rebuilds in the timed phase
+  std::uint64_t listed_pairs = 0;  // pairs in the neighbour list at the end
   std::uint64_t bonds = 0;     // bonded variant: bonds installed (none break: see bench.cpp)
   std::uint64_t state_hash = 0;
   double peak_rss_bytes = 0.0;  // of the process so far (getrusage)
