@@ -54,6 +54,15 @@ protocol::Schema schemaOf(const RigEntry& rig) {
   protocol::Schema s;
   declareCommon(s, names);
   rig.declare(s);
+  s.setRig(std::string(rig.name));
+  for (const RigEntry& other : rigTable()) {
+    if (other.name == rig.name) continue;
+    protocol::Schema theirs;
+    other.declare(theirs);
+    for (const protocol::ParamDecl& d : theirs.all()) {
+      if (!s.find(d.key)) s.addForeign(d.key, std::string(other.name));
+    }
+  }
   return s;
 }
 

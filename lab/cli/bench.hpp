@@ -27,6 +27,7 @@ struct BenchOptions {
   bool bonded = false;               // a parallel bond on every initial contact (cemented rock)
   bool flow = false;                 // also time the pore network and a steady solve on the packing
   bool render = false;               // also time an off-screen snapshot of the packing
+  std::string render_dir = ".";      // where the snapshot's PNGs go
 };
 
 struct BenchResult {
@@ -39,9 +40,9 @@ struct BenchResult {
   double coordination_end = 0.0;
   double wall_stress_start = 0.0;  // Pa, mean of the six walls
   double wall_stress_end = 0.0;
-  std::uint64_t rebuilds = 0;  // neighbour list rebuilds in the timed phase
+  std::uint64_t rebuilds = 0;      // neighbour list rebuilds in the timed phase
   std::uint64_t listed_pairs = 0;  // pairs in the neighbour list at the end
-  std::uint64_t bonds = 0;     // bonded variant: bonds installed (none break: see bench.cpp)
+  std::uint64_t bonds = 0;         // bonded variant: bonds installed (none break: see bench.cpp)
   std::uint64_t state_hash = 0;
   double peak_rss_bytes = 0.0;  // of the process so far (getrusage)
 };

@@ -53,7 +53,7 @@ int runBenchCommand(rocklab::BenchOptions o, bool json) {
   std::vector<FlowBenchResult> flow;
   std::vector<RenderBenchResult> render;
   if (o.flow) flow.push_back(runFlowBench(packing));
-  if (o.render) render.push_back(runRenderBench(packing, "."));
+  if (o.render) render.push_back(runRenderBench(packing, o.render_dir));
   if (!o.flow && !o.render) {
     for (int t : o.threads) results.push_back(runBench(packing, o, t));
   }
@@ -151,7 +151,9 @@ int main(int argc, char** argv) {
   b->add_flag("--flow", bench.flow,
               "Time the pore network (triangulation, network, steady solve) instead");
   b->add_flag("--render", bench.render,
-              "Time an off-screen snapshot (bench-view.png, bench-slice.png here) instead");
+              "Time an off-screen snapshot (bench-view.png, bench-slice.png) instead");
+  b->add_option("--render-dir", bench.render_dir, "Folder of the snapshot's PNGs")
+      ->check(CLI::ExistingDirectory);
   b->add_flag("--json", json, "Print JSON");
   b->callback([&] { action = [&] { return runBenchCommand(bench, json); }; });
 

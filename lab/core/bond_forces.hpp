@@ -1,10 +1,8 @@
 #pragma once
 // The bond stage: one force pass over all parallel bonds, serial or threaded with the same
-// bits. Bonds are kept sorted by their particles (i, then j), so they form rows like the
-// contact pairs and the threaded pass splits them as the contact pass does
-// (contact_model_impl.hpp): each thread owns a run of rows and adds in bond order. Breaks
-// are only recorded during the pass; the simulation removes the broken bonds afterwards, in
-// order (two-phase mutation).
+// bits (the threaded pass stores per-bond results and each particle sums its bonds in bond
+// order, as the serial pass adds them). Breaks are only recorded during the pass; the
+// simulation removes the broken bonds afterwards, in order (two-phase mutation).
 
 #include <cstdint>
 #include <vector>
@@ -33,38 +31,19 @@ class BondForces {
  public:
   void compute(BondPass<D>& pass);
   // Call when bonds are added or removed or particles reordered.
-  void invalidate() { rows_valid_ = false; }
+  void invalidate() { adjacency_valid_ = false; }
 
  private:
-  // One bond's result, kept for the thread that applies it in bond order.
-  struct Kept {
-    Vec<D> force;
-    Ang<D> torque_i, torque_j;  // subtracted from i, added to j
-    bool broken = false;
-    BondBreakMode mode = BondBreakMode::Tensile;
-    double stress = 0.0;
-  };
-  struct Break {
-    std::uint32_t bond;
-    BondBreakMode mode;
-    double stress;
-  };
+  void buildAdjacency(std::size_t particles, const BondStore<D>& bonds);
 
-  void buildRows(std::size_t particles, BondStore<D>& bonds);
-  Kept evaluate(const BondPass<D>& pass, std::uint32_t b) const;
-  void serialPass(BondPass<D>& pass);
-  void threadedPass(BondPass<D>& pass);
-
-  // Bonds by particle: row_[i]..row_[i+1] are i's bonds (to larger j, ascending);
-  // partner_row_/partner_ list the bonds whose j is a particle, ascending.
-  std::vector<std::uint32_t> row_, partner_row_, partner_;
-  bool rows_valid_ = false;
-  std::vector<std::size_t> range_;  // rows of each thread
-  std::vector<std::vector<std::uint32_t>> own_cross_;
-  std::vector<std::uint32_t> cross_;  // bonds reaching past their thread's rows, ascending
-  std::vector<std::size_t> cross_start_;
-  std::vector<Kept> cross_kept_;
-  std::vector<std::vector<Break>> thread_breaks_;
+  // Threaded pass: per-bond results and each particle's bonds as (bond << 1 | side).
+  std::vector<std::uint8_t> active_;
+  std::vector<Vec<D>> force_;
+  std::vector<Ang<D>> torque_i_, torque_j_;
+  std::vector<std::uint32_t> adjacency_row_, adjacency_;
+  bool adjacency_valid_ = false;
+  std::vector<std::vector<std::uint32_t>> block_broken_;
+  std::vector<std::vector<std::pair<BondBreakMode, double>>> block_modes_;
 };
 
 }  // namespace rocklab

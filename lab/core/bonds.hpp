@@ -54,9 +54,6 @@ struct BondKind {
 template <int D>
 struct BondSection {
   double radius = 0.0, area = 0.0, inertia = 0.0, polar = 0.0;
-  // 1 / A, R / I and R / J: the peripheral stresses per force and moment (the divisions
-  // stand apart from the bond's chain of dependent operations, off its critical path).
-  double inv_area = 0.0, r_over_inertia = 0.0, r_over_polar = 0.0;
   static BondSection of(double r, double thickness) {
     BondSection s;
     s.radius = r;
@@ -64,14 +61,10 @@ struct BondSection {
       s.area = std::numbers::pi * r * r;
       s.inertia = std::numbers::pi * r * r * r * r / 4.0;
       s.polar = 2.0 * s.inertia;
-      s.r_over_inertia = 4.0 / (std::numbers::pi * r * r * r);
-      s.r_over_polar = 0.5 * s.r_over_inertia;
     } else {
       s.area = 2.0 * r * thickness;
       s.inertia = 2.0 * r * r * r * thickness / 3.0;
-      s.r_over_inertia = 1.5 / (r * r * thickness);
     }
-    s.inv_area = 1.0 / s.area;
     return s;
   }
 };
@@ -132,12 +125,12 @@ inline BondResult<D> bondForce(const BondSection<D>& s, double kn, double ks,
   r.force = b.fn * n + b.fs;
   if constexpr (D == 3) {
     r.moment = b.mb + b.mt * n;
-    r.shear = b.fs.norm() * s.inv_area + std::abs(b.mt) * s.r_over_polar;
+    r.shear = b.fs.norm() / s.area + std::abs(b.mt) * s.radius / s.polar;
   } else {
     r.moment = b.mb;
-    r.shear = b.fs.norm() * s.inv_area;
+    r.shear = b.fs.norm() / s.area;
   }
-  r.tensile = -b.fn * s.inv_area + angNorm(b.mb) * s.r_over_inertia;
+  r.tensile = -b.fn / s.area + angNorm(b.mb) * s.radius / s.inertia;
   return r;
 }
 
@@ -150,10 +143,9 @@ inline double bondEnergy(const BondSection<D>& s, double kn, double ks, const Bo
   return e;
 }
 
-// All bonds of a scene, in flat arrays, sorted by their particles (the force pass sorts
-// them again after particles are reordered or bonds added) so that forces add up in the
-// same order on any thread count; `i < j` are particle indices, remapped when particles
-// are reordered.
+// All bonds of a scene, in flat arrays. Bonds keep their order (installation order, broken
+// ones removed) so that forces add up in the same order on any thread count; `i < j` are
+// particle indices, remapped when particles are reordered.
 template <int D>
 struct BondStore {
   std::vector<std::uint32_t> i, j;
@@ -166,9 +158,6 @@ struct BondStore {
   std::size_t size() const { return i.size(); }
   // Keeps the bonds whose flag is 0, in order.
   void removeFlagged(const std::vector<std::uint8_t>& broken);
-  // Puts the bonds in the order of their particles (i, then j), the order the force pass
-  // adds them in.
-  void sortByParticles();
 
   template <class Archive>
   void visit(Archive& ar) {

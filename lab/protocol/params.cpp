@@ -129,6 +129,18 @@ ParamDecl& Schema::realList(const std::string& key, const std::string& unit, dou
   return add(std::move(d));
 }
 
+void Schema::addForeign(const std::string& key, const std::string& rig) {
+  foreign_.emplace_back(key, rig);
+}
+
+std::string Schema::foreignRigs(const std::string& key) const {
+  std::string rigs;
+  for (const auto& [k, r] : foreign_) {
+    if (k == key) rigs += (rigs.empty() ? "" : ", ") + r;
+  }
+  return rigs;
+}
+
 const ParamDecl* Schema::find(const std::string& key) const {
   for (const ParamDecl& d : decls_) {
     if (d.key == key) return &d;
@@ -274,6 +286,13 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
         continue;
       }
       const ParamDecl* d = schema.find(key);
+      if (!d && !schema.foreignRigs(key).empty()) {
+        problem(line, "'" + key + "' is a key of the " + schema.foreignRigs(key) + " rig: the " +
+                          schema.rig() +
+                          " rig has no use for it (a scene runs only the effects its rig "
+                          "can use; remove the key or name that rig in protocol.rig)");
+        continue;
+      }
       if (!d) {
         std::string best;
         std::size_t best_d = 4;

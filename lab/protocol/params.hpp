@@ -51,12 +51,22 @@ class Schema {
 
   const ParamDecl* find(const std::string& key) const;
   const std::vector<ParamDecl>& all() const { return decls_; }
+
+  // The rig these keys are for, and the keys other rigs use for effects this one cannot
+  // (a wave source, pore fluid, ...): a protocol giving one is told which rig it belongs to.
+  void setRig(std::string name) { rig_ = std::move(name); }
+  const std::string& rig() const { return rig_; }
+  void addForeign(const std::string& key, const std::string& rig);
+  // The rigs that use `key` ("ultrasonic", "biaxial, envelope"), empty when none.
+  std::string foreignRigs(const std::string& key) const;
   // The help text: one line per key with unit, default, range and doc.
   std::string help() const;
 
  private:
   ParamDecl& add(ParamDecl d);
   std::vector<ParamDecl> decls_;
+  std::string rig_;
+  std::vector<std::pair<std::string, std::string>> foreign_;  // key, rig
 };
 
 // Range helpers for declarations.

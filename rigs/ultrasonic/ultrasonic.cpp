@@ -1,6 +1,7 @@
 #include "rigs/ultrasonic/ultrasonic.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 
@@ -273,7 +274,15 @@ StaticModulus staticModulus(const Specimen<D>& sp, const Settings& s, int axis) 
 struct StageResult {
   std::vector<std::pair<std::string, double>> values;  // name, value (recorded as series)
   double min_wavelength_diameters = INFINITY, max_disagreement = 0.0;
+  // Cost of the stage's own work, for the notebook's stage timings: the pulses (each with
+  // its background copy) and the static cycles, on copies of the sample.
+  double wave_seconds = 0.0, static_seconds = 0.0;
+  std::uint64_t pulses = 0, cycles = 0;
 };
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 template <int D>
 StageResult measureStage(Specimen<D>& sp, const Settings& s, const std::string& stage, bool frames,
@@ -301,7 +310,10 @@ StageResult measureStage(Specimen<D>& sp, const Settings& s, const std::string& 
     Specimen<D> copy = rest.branch();
     WaveSpec spec = waveSpec(copy, s, k);
     spec.frames = frames ? static_cast<int>(s.integer("wave.frames")) : 0;
+    const auto t0 = std::chrono::steady_clock::now();
     const WaveResult w = measureWave(*copy.sim, spec);
+    out.wave_seconds += secondsSince(t0);
+    ++out.pulses;
     rec.wave(toRecord(w, k, stage, step, time));
     for (std::size_t f = 0; f < w.frames.size(); ++f) {
       rec.snapshot(std::string("wave-") + k.name,
@@ -339,7 +351,10 @@ StageResult measureStage(Specimen<D>& sp, const Settings& s, const std::string& 
     constexpr int z = D - 1;
     for (const auto& [axis, name] : {std::pair{z, "modulus_z"}, std::pair{0, "modulus_x"}}) {
       control.tick(stage, step, -1.0, std::string("static cycle ") + name);
+      const auto t0 = std::chrono::steady_clock::now();
       const StaticModulus m = staticModulus(rest, s, axis);
+      out.static_seconds += secondsSince(t0);
+      ++out.cycles;
       put(std::string(name) + "_static_MPa", m.unloading / 1e6);
       put(std::string(name) + "_static_loading_MPa", m.loading / 1e6);
     }
@@ -400,7 +415,10 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   snapshot(sp, s, rec, "loading", "final");
   for (const auto& [name, value] : stages.back().values) rec.result(name, value, "");
   double min_wavelength = INFINITY, disagreement = 0.0;
+  StageResult cost;
   for (const StageResult& r : stages) {
+    cost.wave_seconds += r.wave_seconds, cost.pulses += r.pulses;
+    cost.static_seconds += r.static_seconds, cost.cycles += r.cycles;
     min_wavelength = std::min(min_wavelength, r.min_wavelength_diameters);
     disagreement = std::max(disagreement, r.max_disagreement);
   }
@@ -416,6 +434,8 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
                     "wave.frequency_kHz");
   }
   recordTimings<D>(rec, {sp.sim.get()});
+  rec.stageTiming("waves", cost.wave_seconds, cost.pulses);
+  if (cost.cycles > 0) rec.stageTiming("static_cycles", cost.static_seconds, cost.cycles);
 }
 
 }  // namespace

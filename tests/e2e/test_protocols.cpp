@@ -369,6 +369,45 @@ TEST(Protocols, DisksUnderAStressRamp) {
   std::filesystem::remove(file);
 }
 
+// Simulate only what a scene calls for (DESIGN.md, principle 4): a dry, uncemented sample
+// runs contacts and nothing else, and a key for an effect its rig cannot use is refused
+// with the rig it belongs to.
+TEST(Protocols, ADryUncementedSceneRunsOnlyTheStagesItCallsFor) {
+  Lab lab("dry");
+  const std::string head = "[protocol]\nname = \"dry\"\nrig = \"hydrostatic\"\n";
+  const std::string body = std::string(kSmallSample) +
+                           "[bonds]\nenabled = false\n[loading]\nstress_max_MPa = 20\n"
+                           "stress_rate_MPa_per_s = 20000\n";
+  const std::string file = writeProtocol("dry", head + body);
+  std::string out;
+  ASSERT_EQ(
+      rocklab::testing::runRocklab("run " + file + " --quiet --threads 1 --lab " + lab.path, &out),
+      0)
+      << out;
+  nb::Notebook n(lab.path);
+  EXPECT_NE(scalar(n, "SELECT calls FROM stage_timings WHERE stage = 'contacts'"), "");
+  EXPECT_EQ(scalar(n,
+                   "SELECT count(*) FROM stage_timings WHERE stage IN ('bonds', 'flow', "
+                   "'flow_network', 'flow_solve', 'waves', 'static_cycles')"),
+            "0");
+  EXPECT_EQ(scalar(n, "SELECT count(*) FROM results WHERE name LIKE '%bond%' AND value > 0"), "0");
+
+  const std::string wet = writeProtocol(
+      "wet", head + body + "[wave]\nfrequency_kHz = 100\n[flow]\nupdate_every_steps = 10\n");
+  Lab refused("refused");
+  EXPECT_EQ(rocklab::testing::runRocklab("run " + wet + " --lab " + refused.path, &out), 2);
+  EXPECT_NE(out.find("'wave.frequency_kHz' is a key of the ultrasonic rig: the hydrostatic rig "
+                     "has no use for it"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("'flow.update_every_steps' is a key of the permeameter rig"),
+            std::string::npos)
+      << out;
+  EXPECT_FALSE(std::filesystem::exists(refused.path));
+  std::filesystem::remove(file);
+  std::filesystem::remove(wet);
+}
+
 TEST(Protocols, InvalidProtocolWritesNothing) {
   Lab lab("invalid");
   const auto bad = std::filesystem::temp_directory_path() /
@@ -504,6 +543,10 @@ TEST(QuickProtocols, HydrostaticPermeabilityFollowsKozenyCarman3D) {
                              "SELECT count(*) FROM events WHERE kind = 'pore_pressure' AND "
                              "stage = 'initial'")),
             result(n, "pores"));
+  // The fluid's cost is in the stage timings; the sample is uncemented: no bond stage.
+  EXPECT_NE(scalar(n, "SELECT calls FROM stage_timings WHERE stage = 'flow_network'"), "");
+  EXPECT_NE(scalar(n, "SELECT calls FROM stage_timings WHERE stage = 'flow_solve'"), "");
+  EXPECT_EQ(scalar(n, "SELECT count(*) FROM stage_timings WHERE stage = 'bonds'"), "0");
 }
 
 // Figure 13: plane strain, equal loading in x and y, Kozeny-Carman from an assumed 30%
@@ -623,6 +666,7 @@ TEST(QuickProtocols, UltrasonicVelocitiesRiseWithHydrostaticStress) {
   EXPECT_GE(fronts, 4);  // frames of each wave at the last stage
   std::filesystem::remove_all(rep);
   std::filesystem::remove_all(lab.path + ".files");
+  EXPECT_EQ(scalar(n, "SELECT calls FROM stage_timings WHERE stage = 'waves'"), "12");
 }
 
 // Li & Holt Figure 18b: in uniaxial strain the weakly cemented sample fails at a few
