@@ -135,6 +135,21 @@ class ContactModelImpl final : public ContactModel<D> {
     return true;
   }
 
+  // A pair's force and torques onto both particles, in the serial pass's order.
+  [[gnu::always_inline]] static void scatter(V* force, A* torque, std::size_t i, std::uint32_t j,
+                                             const V& f, const A& ti, const A& tj) {
+    force[i] -= f;
+    force[j] += f;
+    torque[i] -= ti;
+    torque[j] -= tj;
+  }
+
+  void storeBlock(std::size_t b, const ContactDissipation& diss, bool over) {
+    buffers_.block_friction[b] = diss.friction;
+    buffers_.block_viscous[b] = diss.viscous;
+    buffers_.block_over[b] = over;
+  }
+
   void addBlockSums(ContactPass<D>& pass, std::size_t blocks) const {
     const auto& B = buffers_;
     for (std::size_t b = 0; b < blocks; ++b) {
@@ -169,16 +184,11 @@ class ContactModelImpl final : public ContactModel<D> {
         for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
           interact<kEnergy>(v, a, p, diss, over,
                             [&](std::uint32_t j, const V& f, const A& ti, const A& tj) {
-                              force[i] -= f;
-                              force[j] += f;
-                              torque[i] -= ti;
-                              torque[j] -= tj;
+                              scatter(force, torque, i, j, f, ti, tj);
                             });
         }
       }
-      buffers_.block_friction[b] = diss.friction;
-      buffers_.block_viscous[b] = diss.viscous;
-      buffers_.block_over[b] = over;
+      storeBlock(b, diss, over);
     }
     addBlockSums(pass, blocks);
   }
@@ -310,16 +320,11 @@ class ContactModelImpl final : public ContactModel<D> {
             }
             touching += interact<kEnergy>(v, a, p, diss, over,
                                           [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
-                                            force[i] -= f;
-                                            force[j] += f;
-                                            torque[i] -= ti;
-                                            torque[j] -= tj;
+                                            scatter(force, torque, i, j, f, ti, tj);
                                           });
           }
         }
-        B.block_friction[b] = diss.friction;
-        B.block_viscous[b] = diss.viscous;
-        B.block_over[b] = over;
+        storeBlock(b, diss, over);
         B.block_touching[b] = touching;
       }
     }
