@@ -11,7 +11,7 @@ BUILD := build/$(PRESET)
 ROCKLAB := $(BUILD)/rocklab
 DEMO_DIR := build/demo
 
-.PHONY: deps build demo test test-sanitize bench format clean
+.PHONY: deps build demo test test-sanitize bench references gallery format clean
 
 # Installs only the Debian packages that are missing (a no-op when all are present);
 # sudo only when not root.
@@ -51,6 +51,47 @@ test-sanitize: deps
 
 bench: build
 	$(ROCKLAB) bench --threads 1,2
+
+# The regression references of the quick protocols (tests/reference, checked by the e2e tests):
+# each protocol at three seeds; the value at its own seed, the tolerance from their spread.
+# An explicit step: review `git diff tests/reference` before committing.
+references: build
+	$(ROCKLAB) regress update protocols/*-quick.toml --out tests/reference \
+	  --lab build/references.sqlite --seeds 3
+
+# The accuracy gallery (reports/gallery, shown in the README): one cost-accuracy study per rig,
+# each a ladder of one numerical setting, finest first. `make -j2 gallery` runs two at once.
+GALLERY_DIR := build/gallery
+STUDY = $(ROCKLAB) study accuracy --threads 1 --quiet --lab $(GALLERY_DIR)/lab-$@.sqlite \
+  --out $(GALLERY_DIR)/$@
+GALLERY := oedometer biaxial envelope hydrostatic permeameter ultrasonic
+.PHONY: $(GALLERY)
+gallery: $(GALLERY)
+	@echo "gallery: reports/gallery/{$(shell echo $(GALLERY) | tr ' ' ,)}.png"
+define gallery_png
+	@mkdir -p reports/gallery
+	cp $(GALLERY_DIR)/$@/cost-accuracy.png reports/gallery/$@.png
+endef
+oedometer: build
+	$(STUDY) protocols/oedometer-formed-under-stress-quick.toml \
+	  --vary numerics.timestep_safety=0.25,0.5,0.8
+	$(gallery_png)
+biaxial: build
+	$(STUDY) protocols/biaxial-ucs-quick.toml --vary loading.axial_strain_rate_per_s=2.5,5,10,20
+	$(gallery_png)
+envelope: build
+	$(STUDY) protocols/triaxial-envelope-quick.toml \
+	  --vary loading.axial_strain_rate_per_s=5,10,20
+	$(gallery_png)
+hydrostatic: build
+	$(STUDY) protocols/hydrostatic-quick.toml --vary sample.count=4000,2000,1000,500
+	$(gallery_png)
+permeameter: build
+	$(STUDY) protocols/permeameter-hydrostatic-3d-quick.toml --vary sample.count=3000,1500,700
+	$(gallery_png)
+ultrasonic: build
+	$(STUDY) protocols/ultrasonic-hydrostatic-quick.toml --vary numerics.timestep_safety=0.25,0.5,0.8
+	$(gallery_png)
 
 format:
 	git ls-files '*.cpp' '*.hpp' | xargs clang-format -i

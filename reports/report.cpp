@@ -1,5 +1,7 @@
 #include "reports/report.hpp"
 
+#include "reports/key_results.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,6 +16,8 @@
 #include "lab/notebook/notebook.hpp"
 #include "reports/chart.hpp"
 #include "reports/figures/figures.hpp"
+#include "reports/html.hpp"
+#include "reports/key_results.hpp"
 #include "reports/paper.hpp"
 #include "reports/run_data.hpp"
 #include "reports/snapshot.hpp"
@@ -24,37 +28,6 @@ namespace rocklab::reports {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string html(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '&':
-        o += "&amp;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += c;
-    }
-  }
-  return o;
-}
-
-std::string num(double v, int precision = 5) {
-  if (std::isnan(v)) return "&ndash;";
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
-}
 
 // One colour field over the particles of a frame.
 FieldValues field(const std::string& which, const Frame& f, const Frame& first, const RunData& r,
@@ -141,19 +114,6 @@ std::vector<BreakMark> breaksUpTo(const RunData& r, const SnapshotRow& snap) {
   return out;
 }
 
-const char* kStyle = R"(
-body { font-family: sans-serif; max-width: 1100px; margin: 2em auto; color: #222; }
-h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; margin-top: 2em; }
-table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
-td, th { border: 1px solid #ddd; padding: 3px 8px; text-align: left; }
-th { background: #f3f3f3; } td.n { text-align: right; font-variant-numeric: tabular-nums; }
-figure { margin: 1.5em 0; } figure img { max-width: 100%; border: 1px solid #eee; }
-figcaption { font-size: 0.9em; color: #444; margin-top: 0.3em; }
-.status-completed { color: #0a7d32; } .status-failed, .status-interrupted { color: #b00020; }
-.snap { display: flex; flex-wrap: wrap; gap: 1em; } .snap figure { width: 48%; margin: 0.5em 0; }
-details { margin: 0.6em 0; }
-)";
-
 }  // namespace
 
 ReportSummary writeReport(const ReportOptions& o) {
@@ -186,6 +146,18 @@ ReportSummary writeReport(const ReportOptions& o) {
          << (r.reason.empty() ? "" : ": " + html(r.reason)) << "</td><td>" << html(r.started)
          << "</td><td class=\"n\">" << num(r.wall_seconds, 4) << "</td><td><code>"
          << html(r.code_version) << "</code></td><td>" << html(r.build_type) << "</td></tr>\n";
+  }
+  body << "</table>\n";
+
+  // What each protocol is for: its key results (reports/key_results.hpp), first.
+  body << "<h2>Key results</h2>\n<table><tr><th>run</th><th>key result</th><th>value</th>"
+          "<th>unit</th><th>meaning</th></tr>\n";
+  for (const RunData& r : runs) {
+    for (const KeyValue& k : keyResults(r)) {
+      body << "<tr><td>" << r.id << "</td><td>" << html(k.name) << "</td><td class=\"n\">"
+           << (k.value ? num(*k.value) : "not recorded") << "</td><td>" << html(k.unit)
+           << "</td><td>" << html(k.doc) << "</td></tr>\n";
+    }
   }
   body << "</table>\n";
 
@@ -312,9 +284,7 @@ ReportSummary writeReport(const ReportOptions& o) {
   }
 
   std::ofstream index(o.out + "/index.html");
-  index << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-        << "<title>rocklab report</title><style>" << kStyle << "</style></head><body>\n"
-        << body.str() << "</body></html>\n";
+  index << page("rocklab report", body.str());
   if (!index) throw std::runtime_error("cannot write '" + o.out + "/index.html'");
   summary.files.push_back("index.html");
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

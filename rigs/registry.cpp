@@ -70,9 +70,13 @@ CheckedProtocol checkProtocol(const std::string& path) {
   const std::string text = protocol::readFile(path);
   const RigEntry& rig = findRig(protocol::rigOf(path, text), path);
   CheckedProtocol c{&rig, protocol::parseProtocol(path, text, schemaOf(rig))};
-  validateCommon(c.settings);
-  rig.validate(c.settings);
+  validateProtocol(rig, c.settings);
   return c;
+}
+
+void validateProtocol(const RigEntry& rig, const protocol::Settings& s) {
+  validateCommon(s);
+  rig.validate(s);
 }
 
 }  // namespace rocklab::rigs

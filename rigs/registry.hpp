@@ -30,5 +30,7 @@ struct CheckedProtocol {
   protocol::Settings settings;
 };
 CheckedProtocol checkProtocol(const std::string& path);
+// The checks across keys again, after values were replaced (a study's settings).
+void validateProtocol(const RigEntry& rig, const protocol::Settings& s);
 
 }  // namespace rocklab::rigs

@@ -10,6 +10,8 @@
 #include "lab/cli/build_info.hpp"
 #include "lab/core/simulation.hpp"
 #include "lab/notebook/queries.hpp"
+#include "reports/key_results.hpp"
+#include "reports/run_data.hpp"
 #include "rigs/registry.hpp"
 
 namespace rocklab::cli {
@@ -96,7 +98,7 @@ class NotebookRecorder : public rigs::Recorder {
 
 int checkProtocol(const std::string& path) {
   try {
-    const auto c = rigs::checkProtocol(path);
+    const auto c = checkedProtocol(path);
     std::size_t given = 0, total = 0;
     for (const auto& row : c.settings.table()) {
       ++total;
@@ -115,7 +117,10 @@ int listKeys(const std::string& rig) {
   try {
     const auto& r = rigs::findRig(rig, "rocklab keys");
     std::cout << "Keys of " << r.name << " protocols (" << r.doc << "):\n"
-              << rigs::schemaOf(r).help();
+              << rigs::schemaOf(r).help() << "\nKey results a protocol can name in "
+              << "protocol.key_results (a prefix picks a test, copy or stage: test2.NAME, "
+                 "cored.NAME, stage3.NAME):\n"
+              << reports::keyResultHelp(r.name);
     return 0;
   } catch (const protocol::ProtocolError& e) {
     std::cerr << e.what() << "\n";
@@ -123,25 +128,20 @@ int listKeys(const std::string& rig) {
   }
 }
 
-int runProtocol(const RunOptions& o) {
-  // Everything about the protocol is checked before the notebook is touched: an invalid
-  // protocol writes nothing.
-  rigs::CheckedProtocol c{nullptr, {}};
-  try {
-    c = rigs::checkProtocol(o.protocol);
-  } catch (const protocol::ProtocolError& e) {
-    std::cerr << e.what() << "\n";
-    return 2;
-  }
-  protocol::Settings settings = c.settings;
-  if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+rigs::CheckedProtocol checkedProtocol(const std::string& path) {
+  rigs::CheckedProtocol c = rigs::checkProtocol(path);
+  reports::checkKeyResults(c.rig->name, c.settings);
+  return c;
+}
 
-  notebook::Notebook nb(o.lab);
+RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& settings,
+                       const std::string& protocol_file, const std::string& lab, bool quiet) {
+  notebook::Notebook nb(lab);
   notebook::RunInfo info;
   info.protocol = settings.text("protocol.name");
-  info.protocol_file = std::filesystem::absolute(o.protocol).string();
+  info.protocol_file = std::filesystem::absolute(protocol_file).string();
   info.protocol_text = settings.source();
-  info.rig = std::string(c.rig->name);
+  info.rig = std::string(rig.name);
   info.code_version = kGitRevision;
   info.build_type = kBuildType;
   info.seed = settings.integer("protocol.seed");
@@ -154,12 +154,12 @@ int runProtocol(const RunOptions& o) {
   g_signal.store(0);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
-  rigs::RunControl control(!o.quiet && isatty(STDERR_FILENO), interruption);
-  std::cerr << "run " << writer.id() << ": " << info.protocol << " (" << info.rig << ") -> "
-            << o.lab << "\n";
-  int code = 0;
+  rigs::RunControl control(!quiet && isatty(STDERR_FILENO), interruption);
+  std::cerr << "run " << writer.id() << ": " << info.protocol << " (" << info.rig << ") -> " << lab
+            << "\n";
+  RunOutcome out{0, writer.id()};
   try {
-    c.rig->run(settings, rec, control);
+    rig.run(settings, rec, control);
     control.done();
     writer.finish(notebook::RunStatus::Completed);
     std::cerr << "run " << writer.id() << " completed\n";
@@ -167,16 +167,31 @@ int runProtocol(const RunOptions& o) {
     control.done();
     writer.finish(notebook::RunStatus::Interrupted, e.what());
     std::cerr << "run " << writer.id() << " interrupted: " << e.what() << "\n";
-    code = 130;
+    out.code = 130;
   } catch (const std::exception& e) {
     control.done();
     writer.finish(notebook::RunStatus::Failed, e.what());
     std::cerr << "run " << writer.id() << " failed: " << e.what() << "\n";
-    code = 1;
+    out.code = 1;
   }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
-  return code;
+  return out;
+}
+
+int runProtocol(const RunOptions& o) {
+  // Everything about the protocol is checked before the notebook is touched: an invalid
+  // protocol writes nothing.
+  rigs::CheckedProtocol c{nullptr, {}};
+  try {
+    c = checkedProtocol(o.protocol);
+  } catch (const protocol::ProtocolError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  }
+  protocol::Settings settings = c.settings;
+  if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+  return runSettings(*c.rig, settings, o.protocol, o.lab, o.quiet).code;
 }
 
 int notebookCommand(const NotebookOptions& o) {
@@ -188,7 +203,18 @@ int notebookCommand(const NotebookOptions& o) {
   if (o.what == "runs") {
     notebook::printTable(std::cout, notebook::listRuns(nb), o.csv);
   } else if (o.what == "show") {
-    for (const auto& [title, table] : notebook::showRun(nb, o.run)) {
+    auto sections = notebook::showRun(nb, o.run);
+    // The protocol's key results first after the run's row: what the run was for.
+    notebook::Table keys{{"key_result", "value", "unit"}, {}};
+    for (const reports::KeyValue& k : reports::keyResults(reports::loadRun(nb, o.run))) {
+      notebook::Cell name, value, unit;
+      name.type = unit.type = notebook::Cell::Type::Text;
+      name.text = k.name, unit.text = k.unit;
+      if (k.value) value.type = notebook::Cell::Type::Real, value.real = *k.value;
+      keys.rows.push_back({name, value, unit});
+    }
+    sections.insert(sections.begin() + 1, {"key results", keys});
+    for (const auto& [title, table] : sections) {
       if (table.rows.empty() && title != "run") continue;
       if (!o.csv) std::cout << "== " << title << "\n";
       notebook::printTable(std::cout, table, o.csv);

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "rigs/registry.hpp"
+
 namespace rocklab::cli {
 
 struct RunOptions {
@@ -17,6 +19,17 @@ struct RunOptions {
 // Returns the process exit code: 0 completed, 1 failed, 2 invalid protocol, 130 interrupted.
 int runProtocol(const RunOptions& o);
 int checkProtocol(const std::string& path);
+
+// A protocol file read and checked completely, its key results included; throws
+// protocol::ProtocolError.
+rigs::CheckedProtocol checkedProtocol(const std::string& path);
+struct RunOutcome {
+  int code = 0;  // as runProtocol's
+  std::int64_t run = 0;
+};
+// Runs checked settings into the notebook `lab` as one run.
+RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& settings,
+                       const std::string& protocol_file, const std::string& lab, bool quiet);
 int listKeys(const std::string& rig);
 
 struct NotebookOptions {

@@ -8,6 +8,7 @@
 #include "lab/cli/bench.hpp"
 #include "lab/cli/build_info.hpp"
 #include "lab/cli/lab_commands.hpp"
+#include "lab/cli/study_commands.hpp"
 #include "lab/core/contact_laws.hpp"
 #include "lab/core/packing_io.hpp"
 #include "reports/report.hpp"
@@ -176,7 +177,9 @@ int main(int argc, char** argv) {
   std::string keys_rig;
   auto* k =
       app.add_subcommand("keys", "List a rig's protocol keys with units, defaults and ranges");
-  k->add_option("rig", keys_rig, "oedometer, hydrostatic")->required();
+  k->add_option("rig", keys_rig,
+                "oedometer, biaxial, envelope, hydrostatic, permeameter, ultrasonic")
+      ->required();
   k->callback([&] { action = [&] { return rocklab::cli::listKeys(keys_rig); }; });
 
   rocklab::cli::NotebookOptions nbo;
@@ -239,6 +242,75 @@ int main(int argc, char** argv) {
       return 0;
     };
   });
+
+  rocklab::cli::StudyOptions study;
+  auto* st = app.add_subcommand("study", "Studies over many runs of a protocol");
+  st->require_subcommand(1);
+  auto* acc = st->add_subcommand(
+      "accuracy",
+      "Run a protocol over a ladder of numerical settings; report each setting's wall time and "
+      "the deviation of the protocol's key results from the finest (the first value of each "
+      "--vary), the Pareto front and the cheapest setting within --tolerance");
+  acc->add_option("protocol", study.protocol, "Protocol file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  acc->add_option("--vary", study.vary,
+                  "KEY=v1,v2,...: a protocol key and its values, finest first (repeat for more "
+                  "keys: every combination runs)")
+      ->required()
+      ->allow_extra_args(false);
+  acc->add_option("--lab", study.lab, "Lab notebook (SQLite), created if missing");
+  acc->add_option("--out", study.out, "Output folder of the study report")->required();
+  acc->add_option("--tolerance", study.tolerance_percent,
+                  "Largest deviation of a key result accepted (%), to name the cheapest setting")
+      ->check(CLI::Range(1e-6, 1e6));
+  acc->add_option("--threads", study.threads, "Threads of every run (same results)")
+      ->check(CLI::Range(1, 1024));
+  acc->add_flag("--quiet", study.quiet, "No progress line on stderr");
+  acc->add_flag("--dry-run", study.dry_run, "Check every setting and list them; run nothing");
+  acc->callback([&] { action = [&] { return rocklab::cli::studyAccuracy(study); }; });
+
+  std::vector<std::int64_t> study_runs;
+  auto* sr = st->add_subcommand(
+      "report", "Write the report of a study from its runs in the notebook, the finest first");
+  sr->add_option("runs", study_runs, "Run ids of one protocol, the finest setting first")
+      ->required();
+  sr->add_option("--lab", study.lab, "Lab notebook (SQLite)");
+  sr->add_option("--out", study.out, "Output folder of the study report")->required();
+  sr->add_option("--tolerance", study.tolerance_percent,
+                 "Largest deviation of a key result accepted (%), to name the cheapest setting")
+      ->check(CLI::Range(1e-6, 1e6));
+  sr->callback([&] {
+    action = [&] {
+      return rocklab::cli::studyReport(study_runs, study.lab, study.out, study.tolerance_percent);
+    };
+  });
+
+  std::string reference, regress_lab = "lab.sqlite";
+  std::int64_t regress_run = 0;
+  rocklab::cli::RegressUpdateOptions update;
+  auto* rg = app.add_subcommand(
+      "regress", "Key results against reference files (the regression guard), and regenerate them");
+  rg->require_subcommand(1);
+  auto* rgc = rg->add_subcommand("check", "Compare a run's key results with a reference file");
+  rgc->add_option("reference", reference, "Reference file (tests/reference/NAME.toml)")->required();
+  rgc->add_option("--lab", regress_lab, "Lab notebook (SQLite)");
+  rgc->add_option("--run", regress_run, "Run id (default: the newest run of the protocol)");
+  rgc->callback([&] {
+    action = [&] { return rocklab::cli::regressCheck(reference, regress_lab, regress_run); };
+  });
+  auto* rgu = rg->add_subcommand(
+      "update",
+      "Run protocols at several seeds and write their reference files: the value at the "
+      "protocol's seed, the tolerance from the seeds' spread");
+  rgu->add_option("protocols", update.protocols, "Protocol files")
+      ->required()
+      ->check(CLI::ExistingFile);
+  rgu->add_option("--out", update.out, "Folder of the reference files");
+  rgu->add_option("--lab", update.lab, "Lab notebook the runs go to");
+  rgu->add_option("--seeds", update.seeds, "Seeds per protocol")->check(CLI::Range(2, 100));
+  rgu->add_option("--threads", update.threads, "Threads of every run")->check(CLI::Range(1, 1024));
+  rgu->callback([&] { action = [&] { return rocklab::cli::regressUpdate(update); }; });
 
   int dim = 3;
   rocklab::PackingSpec spec;

@@ -813,6 +813,36 @@ std::string Simulation<D>::diagnose() const {
     s << "No single cause stands out: check the stiffness contrast between materials, the "
          "loading rate and guard.overlap_limit.\n";
   }
+  // The deepest contact as it stands: where to look, and how fast it closed.
+  Touching deepest;
+  double ratio = 0.0;
+  forEachTouching([&](const Touching& t) {
+    if (t.overlap / t.min_radius > ratio) ratio = t.overlap / t.min_radius, deepest = t;
+  });
+  if (ratio > 0.0) {
+    const std::size_t i = deepest.i, j = deepest.j;
+    const Vec<D> n =
+        deepest.wall ? Vec<D>(-deepest.wall->normal) : Vec<D>((P.pos[j] - P.pos[i]).normalized());
+    const Vec<D> vj = deepest.wall ? deepest.wall->velocity : P.vel[j];
+    const double closing = (P.vel[i] - vj).dot(n);
+    s << "Deepest contact: particle " << P.slot_of[i] << " (radius " << P.radius[i] << " m, at ("
+      << P.pos[i].transpose() << ")) and ";
+    if (deepest.wall) {
+      s << "wall '" << deepest.wall->name << "'";
+    } else {
+      s << "particle " << P.slot_of[j] << " (radius " << P.radius[j] << " m)";
+    }
+    const double per_step = closing * dt_ / deepest.min_radius;
+    s << ": overlap " << ratio << " of the smaller radius, closing at " << closing << " m/s ("
+      << per_step << " of that radius per step).\n";
+    // A contact that closed slowly carries a load too high for its stiffness: the model's
+    // limit, not the integration's.
+    if (ratio >= config_.guard.overlap_limit && std::abs(per_step) < 1e-4) {
+      s << "It closed slowly: a static load too high for the contact stiffness, not an "
+           "instability. Stiffen the contacts, or raise guard.overlap_limit if an overlap this "
+           "deep is acceptable for the smallest particles.\n";
+    }
+  }
   return s.str();
 }
 

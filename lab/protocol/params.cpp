@@ -31,9 +31,13 @@ std::string show(const Value& v) {
           return x;
         } else if constexpr (std::is_same_v<T, bool>) {
           return x ? "true" : "false";
-        } else {
+        } else if constexpr (std::is_same_v<T, std::vector<double>>) {
           std::string s = "[";
           for (std::size_t k = 0; k < x.size(); ++k) s += (k ? ", " : "") + number(x[k]);
+          return s + "]";
+        } else {
+          std::string s = "[";
+          for (std::size_t k = 0; k < x.size(); ++k) s += (k ? ", \"" : "\"") + x[k] + "\"";
           return s + "]";
         }
       },
@@ -71,7 +75,7 @@ std::string ParamDecl::rangeText() const {
     for (std::size_t k = 0; k < choices.size(); ++k) s += (k ? ", " : "") + choices[k];
     return s;
   }
-  if (kind == Kind::Text || kind == Kind::Flag) return "";
+  if (kind == Kind::Text || kind == Kind::Flag || kind == Kind::TextList) return "";
   return std::string(lo_open ? "(" : "[") + number(lo) + ", " + number(hi) + (hi_open ? ")" : "]");
 }
 
@@ -125,6 +129,15 @@ ParamDecl& Schema::realList(const std::string& key, const std::string& unit, dou
                             std::optional<std::vector<double>> fallback, const std::string& doc) {
   ParamDecl d;
   d.key = key, d.kind = Kind::RealList, d.unit = unit, d.to_si = to_si, d.doc = doc;
+  if (fallback) d.fallback = *fallback;
+  return add(std::move(d));
+}
+
+ParamDecl& Schema::textList(const std::string& key,
+                            std::optional<std::vector<std::string>> fallback,
+                            const std::string& doc) {
+  ParamDecl d;
+  d.key = key, d.kind = Kind::TextList, d.doc = doc;
   if (fallback) d.fallback = *fallback;
   return add(std::move(d));
 }
@@ -207,6 +220,10 @@ std::vector<double> Settings::listSi(const std::string& key) const {
   return v;
 }
 
+const std::vector<std::string>& Settings::texts(const std::string& key) const {
+  return std::get<std::vector<std::string>>(value(key));
+}
+
 std::string Settings::where(const std::string& key) const {
   auto it = given_.find(key);
   return file_ + (it == given_.end() ? "" : ":" + std::to_string(it->second));
@@ -229,6 +246,53 @@ void Settings::override(const std::string& key, Value v) {
     throw ProtocolError({key + " = " + show(v) + " is outside the allowed range " + d.rangeText()});
   }
   values_[key] = std::move(v);
+}
+
+bool Settings::declared(const std::string& key) const {
+  return schema_ && schema_->find(key);
+}
+
+void Settings::overrideText(const std::string& key, const std::string& text) {
+  const ParamDecl* d = schema_ ? schema_->find(key) : nullptr;
+  if (!d) throw ProtocolError({"'" + key + "' is not a key of this protocol's rig"});
+  auto bad = [&](const std::string& expect) {
+    return ProtocolError({key + " = " + text + ": expects " + expect + unitText(*d)});
+  };
+  std::size_t used = 0;
+  try {
+    switch (d->kind) {
+      case Kind::Real: {
+        const double v = std::stod(text, &used);
+        if (used != text.size()) throw bad("a number");
+        override(key, v);
+        return;
+      }
+      case Kind::Integer: {
+        const long long v = std::stoll(text, &used);
+        if (used != text.size()) throw bad("an integer");
+        override(key, static_cast<std::int64_t>(v));
+        return;
+      }
+      case Kind::Choice:
+        if (std::find(d->choices.begin(), d->choices.end(), text) == d->choices.end())
+          throw bad(d->rangeText());
+        [[fallthrough]];
+      case Kind::Text:
+        override(key, text);
+        return;
+      case Kind::Flag:
+        if (text != "true" && text != "false") throw bad("true or false");
+        override(key, text == "true");
+        return;
+      case Kind::RealList:
+      case Kind::TextList:
+        throw bad("one value: a list key cannot be varied from the command line");
+    }
+  } catch (const std::invalid_argument&) {
+    throw bad(d->kind == Kind::Real ? "a number" : "an integer");
+  } catch (const std::out_of_range&) {
+    throw bad("a value in " + d->rangeText());
+  }
 }
 
 void fail(const Settings& s, const std::string& key, const std::string& why) {
@@ -368,6 +432,19 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
             }
           }
           if (!ok) problem(line, expect + "a list of numbers only");
+          s.values_[key] = list;
+          break;
+        }
+        case Kind::TextList: {
+          std::vector<std::string> list;
+          bool ok = v.is_array();
+          if (ok) {
+            for (const auto& e : v.as_array()) {
+              if (e.is_string()) list.push_back(e.as_string().str);
+              ok = ok && e.is_string();
+            }
+          }
+          if (!ok) problem(line, expect + "a list of strings, e.g. [\"a\", \"b\"]");
           s.values_[key] = list;
           break;
         }

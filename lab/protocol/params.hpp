@@ -16,9 +16,10 @@
 
 namespace rocklab::protocol {
 
-enum class Kind { Real, Integer, Text, Choice, Flag, RealList };
+enum class Kind { Real, Integer, Text, Choice, Flag, RealList, TextList };
 
-using Value = std::variant<double, std::int64_t, std::string, bool, std::vector<double>>;
+using Value = std::variant<double, std::int64_t, std::string, bool, std::vector<double>,
+                           std::vector<std::string>>;
 
 struct ParamDecl {
   std::string key;
@@ -48,6 +49,8 @@ class Schema {
   ParamDecl& flag(const std::string& key, std::optional<bool> fallback, const std::string& doc);
   ParamDecl& realList(const std::string& key, const std::string& unit, double to_si,
                       std::optional<std::vector<double>> fallback, const std::string& doc);
+  ParamDecl& textList(const std::string& key, std::optional<std::vector<std::string>> fallback,
+                      const std::string& doc);
 
   const ParamDecl* find(const std::string& key) const;
   const std::vector<ParamDecl>& all() const { return decls_; }
@@ -101,6 +104,7 @@ class Settings {
   bool flag(const std::string& key) const;
   std::vector<double> list(const std::string& key) const;  // in the key's unit
   std::vector<double> listSi(const std::string& key) const;
+  const std::vector<std::string>& texts(const std::string& key) const;
   bool given(const std::string& key) const { return given_.count(key) > 0; }
   // Where a key was set, for errors found across keys ("file:line").
   std::string where(const std::string& key) const;
@@ -109,6 +113,10 @@ class Settings {
   const std::string& file() const { return file_; }
   // Replaces a value after parsing (a command-line override); the range is checked.
   void override(const std::string& key, Value v);
+  // The same from command-line text (`--vary numerics.timestep_safety=0.3`), read as the
+  // key's kind; lists cannot be given this way.
+  void overrideText(const std::string& key, const std::string& text);
+  bool declared(const std::string& key) const;
   const std::string& source() const { return source_; }
 
  private:

@@ -19,6 +19,9 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
   range(s.integer("protocol.dimension", 3, "2 (disks) or 3 (spheres)"), 2, false, 3, false);
   range(s.integer("protocol.seed", 1, "seed of the packing and the bond strengths"), 0, false, 9e15,
         false);
+  s.textList("protocol.key_results", std::vector<std::string>{},
+             "the protocol's key results, from its rig's list (`rocklab keys RIG`): what "
+             "reports headline, accuracy studies compare and regression references guard");
 
   s.choice("sample.kind", {"spheres", "grains", "clumps"}, "spheres",
            "spheres: one disk or sphere per grain; grains: breakable superparticles, pebbles "

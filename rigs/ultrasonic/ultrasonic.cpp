@@ -54,6 +54,10 @@ void declare(protocol::Schema& s) {
   range(s.real("wave.first_break_fraction", "-", 1, 0.1,
                "first-break level, as a fraction of each trace's peak magnitude"),
         0, true, 1, true);
+  range(s.integer("wave.sample_every_steps", 1,
+                  "the receivers' sampling: one sample every this many steps (1: every step; "
+                  "at least four samples per pulse period, checked)"),
+        1, false, 1e6, false);
   range(s.integer("wave.max_window_steps", 200000,
                   "longest recording of one wave; it stops earlier once the farthest receiver "
                   "has heard the pulse"),
@@ -165,6 +169,7 @@ WaveSpec waveSpec(const Specimen<D>& sp, const Settings& s, const WaveKind& k) {
   w.receiver_half_width = s.real("wave.receiver_half_width") * half_width;
   w.first_break_fraction = s.real("wave.first_break_fraction");
   w.max_steps = static_cast<std::uint64_t>(s.integer("wave.max_window_steps"));
+  w.sample_every = static_cast<int>(s.integer("wave.sample_every_steps"));
   return w;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <sstream>
 
 namespace rocklab::rigs::ultrasonic {
 
@@ -30,6 +31,7 @@ void check(const WaveSpec& s, int dimension) {
     }
     last = r;
   }
+  if (s.sample_every < 1) fail("the receivers sample every step or less often, not never");
   if (s.receiver_half_width > 0.0 && static_cast<int>(s.centre.size()) != dimension) {
     fail("a receiver half width needs the sample's centre");
   }
@@ -158,8 +160,17 @@ WaveResult measureWave(Simulation<D>& sim, const WaveSpec& spec) {
     background.emplace(sim.clone());
     background->setDrivenVelocity(source, Vec<D>::Zero());  // the source held still
   }
-  w.dt = sim.dt();
+  const double step_dt = sim.dt();
+  w.dt = step_dt * spec.sample_every;
   const double period = 1.0 / spec.frequency, omega = 2.0 * std::numbers::pi * spec.frequency;
+  if (period < 4.0 * w.dt) {
+    std::ostringstream why;
+    why.precision(3);
+    why << "wave " << spec.name << ": a sample every " << w.dt
+        << " s gives fewer than four per pulse period (" << period
+        << " s): sample more often (wave.sample_every_steps) or lower the frequency";
+    throw WaveError(why.str());
+  }
   Vec<D> direction = Vec<D>::Zero();
   direction[spec.polarisation] = 1.0;
   double near_peak = 0.0, heard_at = -1.0;
@@ -167,27 +178,28 @@ WaveResult measureWave(Simulation<D>& sim, const WaveSpec& spec) {
   for (std::uint64_t n = 0;; ++n) {
     if (n == spec.max_steps) {
       throw WaveError("wave " + spec.name + ": the farthest receiver heard nothing in " +
-                      std::to_string(n) + " steps (" + std::to_string(n * w.dt) +
+                      std::to_string(n) + " steps (" + std::to_string(n * step_dt) +
                       " s): the wave is slower or weaker than expected; raise the window "
                       "(wave.max_window_steps) or lower the frequency");
     }
     // The source moves at the pulse's mid-step velocity (the midpoint rule); the source's
     // samples are thus half a step ahead of the receivers', which the slope does not see.
-    const double t_mid = (static_cast<double>(n) + 0.5) * w.dt;
+    const double t_mid = (static_cast<double>(n) + 0.5) * step_dt;
     const double v = t_mid < period ? spec.amplitude * std::sin(omega * t_mid) : 0.0;
     sim.setDrivenVelocity(source, v * direction);
     sim.step();
     if (background) background->step();  // in lockstep: the arrival test sees the pulse alone
+    const double t = sim.time() - t0;
+    if (static_cast<int>(w.frames.size()) < spec.frames &&
+        t >= period * static_cast<double>(1 + w.frames.size())) {
+      w.frames.push_back(captureFrame(sim));
+    }
+    if ((n + 1) % static_cast<std::uint64_t>(spec.sample_every) != 0) continue;
     w.source.push_back(v);
     for (std::size_t r = 0; r < receivers.size(); ++r) {
       double u = meanVelocity(sim, receivers[r], spec.polarisation);
       if (background) u -= meanVelocity(*background, receivers[r], spec.polarisation);
       w.receivers[r].velocity.push_back(u);
-    }
-    const double t = sim.time() - t0;
-    if (static_cast<int>(w.frames.size()) < spec.frames &&
-        t >= period * static_cast<double>(1 + w.frames.size())) {
-      w.frames.push_back(captureFrame(sim));
     }
     if (t <= period) continue;
     near_peak = std::max(near_peak, std::abs(w.receivers.front().velocity.back()));

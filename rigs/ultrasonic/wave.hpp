@@ -50,20 +50,24 @@ struct WaveSpec {
   // The receivers' own motion without the pulse (a loaded sample still creeps and rings when
   // its walls stop) comes from a second copy run without it, and is subtracted.
   bool subtract_background = true;
+  // The receivers' sampling: one sample every this many steps (a digitiser's rate, 1 / (k dt)),
+  // the instantaneous velocity at that step. 1 records every step; coarser sampling is
+  // cheaper to store and pick, and coarser in time. At least four samples per pulse period.
+  int sample_every = 1;
   int frames = 0;  // wave-front frames: one every pulse period from the pulse's end
 };
 
 struct ReceiverTrace {
   double distance = 0.0;  // m, from the source slab's centre
   std::size_t particles = 0;
-  std::vector<double> velocity;    // m/s, mean along the polarisation, every step
+  std::vector<double> velocity;    // m/s, mean along the polarisation, every sample
   std::size_t picked_samples = 0;  // samples before the far end's echo can arrive
   signal::Pick xcorr, first_break;
 };
 
 struct WaveResult {
   WaveSpec spec;
-  double dt = 0.0;  // s, the sampling step (the simulation's)
+  double dt = 0.0;  // s, the sampling step: sample_every simulation steps
   std::uint64_t steps = 0;
   std::size_t source_particles = 0;
   std::vector<double> source;  // m/s, the source's velocity every step (the wavelet)

@@ -183,4 +183,41 @@ TEST(Cli, BadInputIsRefusedClearly) {
   EXPECT_NE(r.status, 0);
 }
 
+// A study or a regression check with bad input says what is wrong and runs nothing: every
+// setting of a study is checked before its first run.
+TEST(Cli, StudyAndRegressRefuseBadInputBeforeRunning) {
+  const std::string lab = tempPath("study-refused.sqlite"), out = tempPath("study-refused");
+  const std::string protocol =
+      std::string(ROCKLAB_SOURCE_DIR) + "/protocols/biaxial-ucs-quick.toml";
+  auto study = [&](const std::string& vary) {
+    return run("study accuracy " + protocol + " --lab " + lab + " --out " + out + " " + vary);
+  };
+  auto r = study("--vary numerics.timestep_safety=0.3,7");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("numerics.timestep_safety = 7 is outside the allowed range"),
+            std::string::npos)
+      << r.out;
+  r = study("--vary numerics.timestep=0.3");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("numerics.timestep: not a key of biaxial protocols"), std::string::npos)
+      << r.out;
+  r = study("--vary sample.count=many");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("sample.count = many: expects an integer"), std::string::npos) << r.out;
+  r = study("--vary numerics.timestep_safety");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("expects KEY=v1,v2"), std::string::npos) << r.out;
+  r = study("--vary numerics.timestep_safety=0.3 --vary numerics.timestep_safety=0.4");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("varied twice"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(lab));
+  EXPECT_FALSE(std::filesystem::exists(out));
+
+  r = run("regress check /nonexistent/reference.toml --lab " + lab);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("no such reference file"), std::string::npos) << r.out;
+  r = run("regress update " + protocol + " --seeds 1");
+  EXPECT_NE(r.status, 0);
+}
+
 }  // namespace

@@ -54,17 +54,28 @@ std::string scalar(nb::Notebook& n, const std::string& sql) {
   return t.rows.empty() ? "" : t.rows[0][0].str();
 }
 
-TEST(QuickProtocols, OedometerFormedUnderStressShowsFigures1And2) {
-  Lab lab("oedometer");
+// Runs a quick protocol into its own notebook and returns it. Every quick protocol passes
+// here, so every one is also held to its regression reference: its key results within the
+// tolerances of tests/reference/<protocol>.toml (twice their spread over three seeds;
+// `make references` regenerates the files, for review).
+nb::Notebook runQuick(const Lab& lab, const std::string& protocol) {
   std::string out;
-  ASSERT_EQ(rocklab::testing::runRocklab("run " + sourceDir() +
-                                             "/protocols/oedometer-formed-under-stress-quick.toml"
-                                             " --quiet --threads 1 --lab " +
-                                             lab.path,
+  EXPECT_EQ(rocklab::testing::runRocklab("run " + sourceDir() + "/protocols/" + protocol +
+                                             ".toml --quiet --threads 1 --lab " + lab.path,
                                          &out),
             0)
       << out;
-  nb::Notebook n(lab.path);
+  EXPECT_EQ(rocklab::testing::runRocklab("regress check " + sourceDir() + "/tests/reference/" +
+                                             protocol + ".toml --lab " + lab.path,
+                                         &out),
+            0)
+      << out;
+  return nb::Notebook(lab.path);
+}
+
+TEST(QuickProtocols, OedometerFormedUnderStressShowsFigures1And2) {
+  Lab lab("oedometer");
+  nb::Notebook n = runQuick(lab, "oedometer-formed-under-stress-quick");
   EXPECT_EQ(scalar(n, "SELECT status FROM runs"), "completed");
 
   // Non-linear: the tangent modulus falls as bonds break (measured 3.5 -> 2.0 GPa, ratio
@@ -103,15 +114,7 @@ TEST(QuickProtocols, OedometerFormedUnderStressShowsFigures1And2) {
 
 TEST(QuickProtocols, CoredSampleIsSofterAtFirstThanTheVirgin) {
   Lab lab("coring");
-  std::string out;
-  ASSERT_EQ(rocklab::testing::runRocklab("run " + sourceDir() +
-                                             "/protocols/oedometer-core-damage-quick.toml"
-                                             " --quiet --threads 1 --lab " +
-                                             lab.path,
-                                         &out),
-            0)
-      << out;
-  nb::Notebook n(lab.path);
+  nb::Notebook n = runQuick(lab, "oedometer-core-damage-quick");
   // Measured 0.57: coring broke most bonds (released the stress they were cemented under).
   EXPECT_LT(result(n, "cored_to_virgin_initial_modulus_ratio"), 0.8);
   EXPECT_GT(result(n, "broken_bonds_by_coring"), 0.3 * result(n, "bonds_installed"));
@@ -125,14 +128,7 @@ TEST(QuickProtocols, CoredSampleIsSofterAtFirstThanTheVirgin) {
 
 TEST(QuickProtocols, HydrostaticCellRuns) {
   Lab lab("hydrostatic");
-  std::string out;
-  ASSERT_EQ(rocklab::testing::runRocklab(
-                "run " + sourceDir() +
-                    "/protocols/hydrostatic-quick.toml --quiet --threads 1 --lab " + lab.path,
-                &out),
-            0)
-      << out;
-  nb::Notebook n(lab.path);
+  nb::Notebook n = runQuick(lab, "hydrostatic-quick");
   EXPECT_NEAR(result(n, "mean_stress_peak_MPa"), 60.0, 0.6);
   EXPECT_LT(result(n, "porosity_at_peak"), result(n, "porosity_after_formation"));
   EXPECT_GT(result(n, "broken_bonds_at_peak"), 0.0);
@@ -158,19 +154,6 @@ porosity_initial = 0.42
 axial_stress_MPa = 10
 lateral_stress_MPa = 5
 )";
-
-// A loading fast for the grains' inertia is flagged in the notebook, not passed off as a
-// quasi-static test.
-// Runs a quick protocol into its own notebook and returns it.
-nb::Notebook runQuick(const Lab& lab, const std::string& protocol) {
-  std::string out;
-  EXPECT_EQ(rocklab::testing::runRocklab("run " + sourceDir() + "/protocols/" + protocol +
-                                             ".toml --quiet --threads 1 --lab " + lab.path,
-                                         &out),
-            0)
-      << out;
-  return nb::Notebook(lab.path);
-}
 
 // Li & Holt section 2.3: the superparticle sample's UCS is 9.9 MPa (calibrated: measured
 // 9.77 MPa on the quick sample; +-25% allows for another seed of 250 grains).
@@ -328,6 +311,8 @@ axial_strain_max = 0.004
   EXPECT_EQ(scalar(n, "SELECT count(*) FROM results WHERE name = 'grain_bonds_installed'"), "0");
 }
 
+// A loading fast for the grains' inertia is flagged in the notebook, not passed off as a
+// quasi-static test.
 TEST(Protocols, FastLoadingIsFlaggedAsNotQuasiStatic) {
   Lab lab("fast");
   const std::string file = writeProtocol(
@@ -433,6 +418,71 @@ TEST(Protocols, InvalidProtocolWritesNothing) {
                 "check " + sourceDir() + "/protocols/oedometer-formed-under-stress.toml", &out),
             0)
       << out;
+}
+
+// A study end to end on the cheapest quick protocol: two settings of the re-triangulation
+// threshold, each a run in the notebook with its value, compared on the key results.
+TEST(Protocols, AccuracyStudyRunsTheLadderAndReportsIt) {
+  Lab lab("study");
+  const std::string out_dir = lab.path + ".study";
+  std::string out;
+  ASSERT_EQ(rocklab::testing::runRocklab(
+                "study accuracy " + sourceDir() +
+                    "/protocols/permeameter-hydrostatic-3d-quick.toml --quiet --threads 1"
+                    " --vary flow.retriangulate_displacement_radii=0.25,2 --tolerance 50 --lab " +
+                    lab.path + " --out " + out_dir,
+                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("cheapest within 50%: run "), std::string::npos) << out;
+  nb::Notebook n(lab.path);
+  EXPECT_EQ(scalar(n, "SELECT group_concat(value, ' ') FROM (SELECT value FROM params WHERE key = "
+                      "'flow.retriangulate_displacement_radii' ORDER BY run_id)"),
+            "0.25 2");
+  EXPECT_EQ(scalar(n, "SELECT count(*) FROM runs WHERE status = 'completed'"), "2");
+  std::ifstream page(out_dir + "/index.html");
+  const std::string html((std::istreambuf_iterator<char>(page)), {});
+  EXPECT_NE(html.find("flow.retriangulate_displacement_radii = 2"), std::string::npos);
+  EXPECT_NE(html.find("k_over_k0_final"), std::string::npos);
+  EXPECT_GT(std::filesystem::file_size(out_dir + "/cost-accuracy.png"), 5000u);
+  std::filesystem::remove_all(out_dir);
+  std::filesystem::remove_all(lab.path + ".files");
+}
+
+// The regression check on a run whose key results are known: within the reference's
+// tolerance it passes, beyond it (or with a key result the run did not record) it fails and
+// names the key result.
+TEST(Protocols, RegressCheckFailsAKeyResultMovedBeyondItsTolerance) {
+  Lab lab("regress");
+  {
+    nb::Notebook n(lab.path);
+    nb::RunInfo info;
+    info.protocol = "biaxial-ucs-quick";
+    info.rig = "biaxial";
+    nb::RunWriter w(n, info, {{"protocol.key_results", "[\"ucs_MPa\"]", ""}});
+    w.result("ucs_MPa", 9.8, "MPa");
+    w.finish(nb::RunStatus::Completed);
+  }
+  auto check = [&](const std::string& results) {
+    const std::string ref =
+        writeProtocol("reference", "protocol = \"biaxial-ucs-quick\"\n" + results);
+    std::string out;
+    const int code =
+        rocklab::testing::runRocklab("regress check " + ref + " --lab " + lab.path, &out);
+    return std::pair{code, out};
+  };
+  auto [code, out] = check("[results.ucs_MPa]\nvalue = 9.5\ntolerance = 0.5\n");
+  EXPECT_EQ(code, 0) << out;
+  std::tie(code, out) = check("[results.ucs_MPa]\nvalue = 9.0\ntolerance = 0.5\nunit = \"MPa\"\n");
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_NE(out.find("FAIL ucs_MPa = 9.8 MPa, reference 9.0 +- 0.5 MPa"), std::string::npos) << out;
+  std::tie(code, out) = check(
+      "[results.ucs_MPa]\nvalue = 9.8\ntolerance = 0.1\n"
+      "[results.band_angle_deg]\nvalue = 30.0\ntolerance = 5.0\n");
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_NE(out.find("FAIL band_angle_deg = not recorded"), std::string::npos) << out;
+  std::tie(code, out) = check("[results.ucs_MPa]\nvalue = 9.8\n");  // no tolerance
+  EXPECT_EQ(code, 2) << out;
 }
 
 // SIGTERM during a run: the run is closed as interrupted, with what it recorded until then.

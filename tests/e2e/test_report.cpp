@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 
 #include "lab/core/frame.hpp"
@@ -153,6 +154,15 @@ TEST_F(Report, PermeameterFiguresAreDrawnWithTheirData) {
     while (std::getline(csv, line)) ++rows;
     EXPECT_GT(rows, 4) << id;
   }
+  // The protocol's key results headline the report, evaluated (a number, not "not recorded").
+  std::ifstream in(rep + "/index.html");
+  const std::string html((std::istreambuf_iterator<char>(in)), {});
+  const auto keys = html.find("<h2>Key results</h2>");
+  ASSERT_NE(keys, std::string::npos);
+  EXPECT_LT(keys, html.find("<h2>Figures</h2>"));
+  const auto row = html.find("<td>k_over_k0_at_half_peak_stress</td><td class=\"n\">0.", keys);
+  EXPECT_NE(row, std::string::npos);
+  EXPECT_EQ(html.find("not recorded"), std::string::npos);
 }
 
 TEST_F(Report, MissingRunsAndLabsAreRefused) {

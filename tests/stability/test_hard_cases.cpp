@@ -186,6 +186,53 @@ TEST(HardCases, AutomaticStepFollowsHertzStiffening) {
   EXPECT_GT(smallest_ratio, 1.0);
 }
 
+// A brittle sample at high stress: cemented while squeezed (every contact overlapping), with
+// strengths of little scatter, then unloaded at once (the walls move away). The bonds take
+// the strain energy the contacts release and fail in a cascade, most of them within a few
+// hundred steps; the broken bonds' energy becomes motion. The run must take it: finite
+// state, and the energy ledger balanced.
+TEST(HardCases, BrittleSampleAtHighStressBreaksInACascade) {
+  PackingSpec spec;
+  spec.count = 1200;
+  spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
+  spec.porosity = 0.36;  // beyond jamming: the contacts hold a high stress
+  const Packing<3> p = generatePacking<3>(spec);
+  SimulationConfig cfg;
+  cfg.contact_law = "hertz";
+  cfg.local_damping = 0.0;  // nothing soaks up the cascade but the contacts' dashpots
+  Simulation<3> sim(testing::table(testing::hertzMaterial(1e9, 0.25, 0.5, 0.05)), cfg);
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    testing::addParticle<3>(sim, p.centers[i], p.radii[i], V3::Zero());
+  }
+  testing::addBox<3>(sim, p.lo, p.hi);
+  BondKind brittle;
+  brittle.modulus = 1e9;
+  brittle.tensile_mean = brittle.shear_mean = 2e6;
+  brittle.tensile_std = brittle.shear_std = 0.05e6;
+  const CementReport cement = sim.cement(sim.addBondKind(brittle), 0.0);
+  ASSERT_GT(cement.installed, 2 * p.centers.size());
+  for (int w = 0; w < 6; ++w) sim.wall(w).velocity = -2.0 * sim.wall(w).normal;
+  auto broken = [&] {
+    return sim.brokenBonds(0, BondBreakMode::Tensile) + sim.brokenBonds(0, BondBreakMode::Shear);
+  };
+  std::uint64_t most_in_a_window = 0, before = 0;
+  for (int k = 0; k < 20; ++k) {
+    ASSERT_NO_THROW(sim.run(100));
+    ASSERT_TRUE(allFinite(sim)) << "after " << sim.steps() << " steps";
+    most_in_a_window = std::max(most_in_a_window, broken() - before);
+    before = broken();
+  }
+  // A cascade: most bonds broke, a large share of them within 100 steps.
+  EXPECT_GT(broken(), cement.installed / 2);
+  EXPECT_GT(most_in_a_window, cement.installed / 5);
+  const EnergyReport e = sim.energy();
+  EXPECT_GT(e.ledger.bond_breakage, 0.0);
+  // The ledger closes to 1% of the energy in play: what the leapfrog scheme's first-order
+  // work sums allow (the same bound as the impact and energy validation tests).
+  EXPECT_LT(std::abs(e.imbalance()), 0.01 * (e.ledger.initial + std::abs(e.ledger.boundary_work)));
+  EXPECT_LT(e.kinetic(), e.ledger.initial + std::abs(e.ledger.boundary_work));
+}
+
 TEST(HardCases, OneParticleAndEmptyScenes) {
   Simulation<3> one(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), SimulationConfig{});
   testing::addParticle<3>(one, V3::Zero(), 1e-3, V3(0.1, 0, 0));

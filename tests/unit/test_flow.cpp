@@ -1,6 +1,6 @@
 // The pore network: geometry against hand computation, the solvers against each other and
-// against Darcy's linear pressure, the explicit scheme's critical step, merging, and the
-// inputs no network can be built from.
+// against Darcy's linear pressure, the explicit scheme's critical step and merging. The
+// inputs no network can be built from are stability cases (tests/stability).
 
 #include <gtest/gtest.h>
 
@@ -12,6 +12,7 @@
 #include "lab/flow/network.hpp"
 #include "lab/flow/solver.hpp"
 #include "lab/flow/triangulation.hpp"
+#include "tests/flow_support.hpp"
 
 namespace rocklab::flow {
 namespace {
@@ -22,58 +23,6 @@ constexpr double kPi = std::numbers::pi;
 double handConductance(double S, double r, double mu) {
   const double re = std::sqrt(S / kPi);
   return kPi * std::pow(re, 4) / (8.0 * mu * r);
-}
-
-// A homogeneous pack on a lattice whose triangulation is unique (no four co-circular or
-// five co-spherical centres): triangular in 2D (spacing 1), body-centred cubic in 3D (cube
-// side 1), n[d] cells per axis; centres moved by up to +-jitter, radii within +-10%.
-template <int D>
-PackView<D> latticePack(const std::array<int, D>& n, double radius, double jitter,
-                        std::uint64_t seed) {
-  Rng rng(seed);
-  PackView<D> p;
-  auto add = [&](Vec<D> x) {
-    for (int d = 0; d < D; ++d) x[d] += rng.uniform(-jitter, jitter);
-    p.centre.push_back(x);
-    p.radius.push_back(radius * rng.uniform(0.9, 1.1));
-  };
-  if constexpr (D == 2) {
-    const double row = std::sqrt(3.0) / 2.0;
-    for (int j = 0; j < n[1]; ++j) {
-      for (int i = 0; i < n[0]; ++i) add({i + 0.5 * (j % 2), j * row});
-    }
-  } else {
-    for (int k = 0; k < n[2]; ++k) {
-      for (int j = 0; j < n[1]; ++j) {
-        for (int i = 0; i < n[0]; ++i) {
-          add({double(i), double(j), double(k)});
-          if (i + 1 < n[0] && j + 1 < n[1] && k + 1 < n[2]) add({i + 0.5, j + 0.5, k + 0.5});
-        }
-      }
-    }
-  }
-  return p;
-}
-
-// The network of a pack, its hull trimmed as the coupling does.
-template <int D>
-Network<D> networkOf(const PackView<D>& p) {
-  auto t = triangulate<D>(p.centre, p.radius);
-  trimHull<D>(t, p.centre, p.radius, 2.0);
-  Network<D> net(std::move(t), 1.0);
-  net.measure(p, {});
-  return net;
-}
-
-template <int D>
-std::vector<PoreBoundary> endLayers(const Network<D>& net, double lo, double hi) {
-  std::vector<PoreBoundary> b(net.pores(), PoreBoundary::Free);
-  for (std::size_t c = 0; c < net.pores(); ++c) {
-    const double h = net.centroid()[c][D - 1];
-    if (h >= hi) b[c] = PoreBoundary::Inlet;
-    if (h <= lo) b[c] = PoreBoundary::Outlet;
-  }
-  return b;
 }
 
 TEST(FlowGeometry, SolidAngleOfAnOctantIsHalfPi) {
@@ -294,23 +243,6 @@ TEST(FlowNetwork, MergingKeepsVolumeAndNeverJoinsInletToOutlet) {
   EXPECT_NEAR(q_merged / q_all, 1.0, 0.25);
   // The small-pore rule lifts the critical step.
   EXPECT_GT(criticalFlowStep(merged, 1.0), criticalFlowStep(all, 1.0));
-}
-
-TEST(FlowNetwork, DegenerateInputIsRefusedWithTheReason) {
-  std::vector<Vec<3>> plane;
-  for (int i = 0; i < 4; ++i) {
-    for (int j = 0; j < 4; ++j) plane.push_back({double(i), double(j), 0.0});
-  }
-  try {
-    triangulate<3>(plane, std::vector<double>(plane.size(), 0.4));
-    FAIL() << "co-planar centres were accepted";
-  } catch (const DegenerateNetwork& e) {
-    EXPECT_NE(std::string(e.what()).find("one plane"), std::string::npos) << e.what();
-  }
-  std::vector<Vec<2>> line{{0, 0}, {1, 1}, {2, 2}, {3, 3}};
-  EXPECT_THROW(triangulate<2>(line, std::vector<double>(4, 0.4)), DegenerateNetwork);
-  std::vector<Vec<3>> one{{0, 0, 0}};
-  EXPECT_THROW(triangulate<3>(one, {0.5}), DegenerateNetwork);
 }
 
 }  // namespace

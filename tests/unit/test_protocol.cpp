@@ -19,6 +19,7 @@ Schema schema() {
   s.flag("output.quiet", false, "no progress");
   range(s.realList("loading.cycle_at_axial_strain", "-", 1, std::vector<double>{}, "cycles"), 0,
         true, 1, true);
+  s.textList("protocol.key_results", std::vector<std::string>{}, "key results");
   return s;
 }
 
@@ -111,6 +112,74 @@ TEST(Protocol, HelpListsKeysWithUnitsDefaultsAndRanges) {
   EXPECT_NE(h.find("numerics.local_damping (-) = 0.7  [0, 1)"), std::string::npos) << h;
   EXPECT_NE(h.find("formation.axial_stress_MPa (MPa)  (required)  (0, 500]"), std::string::npos)
       << h;
+}
+
+TEST(Protocol, ListsOfNamesAreReadAndShown) {
+  const Schema sc = schema();
+  const Settings s = parseProtocol("p.toml", kGood, sc);  // no key_results: the default
+  EXPECT_TRUE(s.texts("protocol.key_results").empty());
+  const std::string text = R"(
+[protocol]
+name = "t"
+rig = "oedometer"
+key_results = ["ucs_MPa", "test2.band_angle_deg"]
+[formation]
+axial_stress_MPa = 30
+)";
+  const Settings t = parseProtocol("p.toml", text, sc);
+  EXPECT_EQ(t.texts("protocol.key_results"),
+            (std::vector<std::string>{"ucs_MPa", "test2.band_angle_deg"}));
+  bool shown = false;
+  for (const ParamRow& r : t.table()) {
+    if (r.key == "protocol.key_results") {
+      EXPECT_EQ(r.value, "[\"ucs_MPa\", \"test2.band_angle_deg\"]");
+      shown = true;
+    }
+  }
+  EXPECT_TRUE(shown);
+  std::string e;
+  try {
+    parseProtocol("p.toml",
+                  "[protocol]\nname = \"t\"\nrig = \"o\"\nkey_results = [1, 2]\n"
+                  "[formation]\naxial_stress_MPa = 3\n",
+                  sc);
+  } catch (const ProtocolError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("p.toml:4: 'protocol.key_results' expects a list of strings"), std::string::npos)
+      << e;
+}
+
+TEST(Protocol, CommandLineValuesAreReadAsTheKeysKindAndChecked) {
+  const Schema sc = schema();
+  Settings s = parseProtocol("p.toml", kGood, sc);
+  s.overrideText("numerics.local_damping", "0.35");
+  EXPECT_DOUBLE_EQ(s.real("numerics.local_damping"), 0.35);
+  s.overrideText("sample.count", "500");
+  EXPECT_EQ(s.integer("sample.count"), 500);
+  s.overrideText("bonds.negative_strength", "resample");
+  EXPECT_EQ(s.text("bonds.negative_strength"), "resample");
+  s.overrideText("output.quiet", "true");
+  EXPECT_TRUE(s.flag("output.quiet"));
+  auto error = [&](const std::string& key, const std::string& text) {
+    try {
+      s.overrideText(key, text);
+    } catch (const ProtocolError& x) {
+      return std::string(x.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("numerics.local_damping", "1.5").find("outside the allowed range [0, 1)"),
+            std::string::npos);
+  EXPECT_NE(error("numerics.local_damping", "fast").find("expects a number (-)"),
+            std::string::npos);
+  EXPECT_NE(error("sample.count", "2.5").find("expects an integer"), std::string::npos);
+  EXPECT_NE(error("bonds.negative_strength", "drop").find("one of: skip, resample"),
+            std::string::npos);
+  EXPECT_NE(error("loading.cycle_at_axial_strain", "0.1").find("cannot be varied"),
+            std::string::npos);
+  EXPECT_NE(error("numerics.damping", "0.1").find("not a key"), std::string::npos);
+  EXPECT_DOUBLE_EQ(s.real("numerics.local_damping"), 0.35);  // a refused value changes nothing
 }
 
 }  // namespace

@@ -1,0 +1,196 @@
+// Key results: each definition evaluated on run data built by hand, where the right value is
+// known exactly; a protocol naming an undefined key result is refused with its file and line;
+// the accuracy study's error, Pareto front and cheapest setting on notebook runs of known
+// values and times.
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "lab/notebook/notebook.hpp"
+#include "reports/key_results.hpp"
+#include "reports/study.hpp"
+
+namespace rocklab::reports {
+namespace {
+
+void addSeries(RunData& r, const std::string& name, const std::vector<double>& v,
+               std::uint64_t step0 = 0) {
+  SeriesData& s = r.series[name];
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    s.step.push_back(step0 + 100 * k);
+    s.value.push_back(v[k]);
+  }
+}
+
+RunData biaxialRun() {
+  RunData r;
+  r.rig = "biaxial";
+  // q = 1000 eps up to the peak of 30 at 3% strain, then softening.
+  std::vector<double> eps, q;
+  for (int k = 0; k <= 40; ++k) {
+    eps.push_back(0.001 * k);
+    q.push_back(k <= 30 ? 1000.0 * eps.back() : 30.0 - 2000.0 * (eps.back() - 0.03));
+  }
+  addSeries(r, "axial_strain", eps);
+  addSeries(r, "deviatoric_stress_MPa", q);
+  r.results["peak_deviatoric_stress_MPa"] = {30.0, "MPa"};
+  r.results["broken_bonds_tensile"] = {12.0, ""};
+  r.results["broken_bonds_shear"] = {5.0, ""};
+  r.params.emplace_back("protocol.key_results",
+                        R"(["peak_deviatoric_stress_MPa", "deviatoric_stress_at_1pct_strain_MPa", )"
+                        R"("tangent_modulus_at_1pct_strain_MPa", "secant_modulus_50_MPa", )"
+                        R"("broken_bonds_total", "band_angle_deg"])",
+                        "");
+  return r;
+}
+
+TEST(KeyResults, EachDefinitionReadsWhatItSays) {
+  const RunData r = biaxialRun();
+  const std::vector<KeyValue> k = keyResults(r);
+  ASSERT_EQ(k.size(), 6u);
+  EXPECT_EQ(k[0].name, "peak_deviatoric_stress_MPa");
+  EXPECT_DOUBLE_EQ(*k[0].value, 30.0);
+  EXPECT_EQ(k[0].unit, "MPa");
+  EXPECT_NEAR(*k[1].value, 10.0, 1e-9);    // interpolated at 1% strain
+  EXPECT_NEAR(*k[2].value, 1000.0, 1e-6);  // the local slope
+  EXPECT_NEAR(*k[3].value, 1000.0, 1e-6);  // 15 MPa at 1.5% strain
+  EXPECT_DOUBLE_EQ(*k[4].value, 17.0);     // both modes
+  EXPECT_FALSE(evaluateKeyResult(r, "broken_bond_fraction").has_value());  // none installed
+  RunData cemented = r;
+  cemented.results["bonds_installed"] = {68.0, ""};
+  EXPECT_DOUBLE_EQ(*evaluateKeyResult(cemented, "broken_bond_fraction"), 0.25);
+  EXPECT_FALSE(k[5].value.has_value());    // no band recorded: missing, not zero
+}
+
+TEST(KeyResults, PrefixesPickATestACopyOrAStage) {
+  RunData env;
+  env.rig = "envelope";
+  env.results["test2.ucs_MPa"] = {9.5, "MPa"};
+  EXPECT_DOUBLE_EQ(*evaluateKeyResult(env, "test2.ucs_MPa"), 9.5);
+  EXPECT_FALSE(evaluateKeyResult(env, "test3.ucs_MPa").has_value());
+  EXPECT_FALSE(evaluateKeyResult(env, "not_a_result").has_value());
+
+  RunData us;
+  us.rig = "ultrasonic";
+  addSeries(us, "stage.density_kg_per_m3", {2000, 2001, 2002}, 1000);  // steps 1000, 1100, 1200
+  // vp_z drowned at stage 2: no record at step 1100.
+  us.series["vp_z"] = {{1000, 1200}, {1500.0, 1700.0}};
+  us.results["vp_z"] = {1700.0, ""};
+  EXPECT_DOUBLE_EQ(*evaluateKeyResult(us, "stage1.vp_z"), 1500.0);
+  EXPECT_FALSE(evaluateKeyResult(us, "stage2.vp_z").has_value());
+  EXPECT_DOUBLE_EQ(*evaluateKeyResult(us, "stage3.vp_z"), 1700.0);
+  EXPECT_DOUBLE_EQ(*evaluateKeyResult(us, "vp_z"), 1700.0);  // the last stage
+  EXPECT_FALSE(evaluateKeyResult(us, "stage4.vp_z").has_value());
+
+  RunData perm;
+  perm.rig = "permeameter";
+  addSeries(perm, "flow.mean_stress_MPa", {0.0, 2.0, 4.0, 6.0, 8.0});
+  addSeries(perm, "k_over_k0", {1.0, 0.9, 0.8, 0.7, 0.6});
+  EXPECT_NEAR(*evaluateKeyResult(perm, "k_over_k0_at_half_peak_stress"), 0.8, 1e-12);
+}
+
+TEST(KeyResults, AProtocolNamingAnUndefinedResultIsRefused) {
+  protocol::Schema sc;
+  sc.text("protocol.name", std::nullopt, "");
+  sc.textList("protocol.key_results", std::vector<std::string>{}, "");
+  const auto s = protocol::parseProtocol(
+      "p.toml", "[protocol]\nname = \"t\"\nkey_results = [\"ucs_MPa\", \"ucs_GPa\"]\n", sc);
+  EXPECT_NO_THROW(checkKeyResults(
+      "biaxial", protocol::parseProtocol("q.toml", "[protocol]\nname = \"t\"\n", sc)));
+  try {
+    checkKeyResults("biaxial", s);
+    FAIL() << "no error";
+  } catch (const protocol::ProtocolError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("p.toml:3: protocol.key_results: 'ucs_GPa' is not a key result of the "
+                     "biaxial rig: one of peak_deviatoric_stress_MPa, ucs_MPa"),
+              std::string::npos)
+        << m;
+    EXPECT_EQ(m.find("'ucs_MPa'"), std::string::npos) << m;
+  }
+}
+
+// Four runs in a notebook, of known wall times and peak stresses: the study's numbers follow.
+TEST(AccuracyStudy, ErrorParetoFrontAndCheapestWithinTolerance) {
+  const std::string lab = (std::filesystem::temp_directory_path() /
+                           ("rocklab-study-" + std::to_string(::getpid()) + ".sqlite"))
+                              .string();
+  std::filesystem::remove(lab);
+  struct Row {
+    double safety, seconds, peak;
+    bool completes;
+  };
+  // The finest first; 0.6 is fast but 8% off; 0.4 is 2% off; 0.5 is slower than 0.4 and
+  // worse (off the front); 0.9 failed.
+  const std::vector<Row> rows = {{0.2, 100, 25.0, true},
+                                 {0.4, 40, 25.5, true},
+                                 {0.5, 50, 26.0, true},
+                                 {0.6, 20, 27.0, true},
+                                 {0.9, 10, 0.0, false}};
+  std::vector<std::int64_t> ids;
+  {
+    notebook::Notebook nb(lab);
+    for (const Row& row : rows) {
+      notebook::RunInfo info;
+      info.protocol = "biaxial-ucs-quick";
+      info.rig = "biaxial";
+      notebook::RunWriter w(nb, info,
+                            {{"numerics.timestep_safety", std::to_string(row.safety), "-"},
+                             {"numerics.threads", "1", "-"},
+                             {"protocol.key_results", "[\"peak_deviatoric_stress_MPa\"]", ""}});
+      if (row.completes) w.result("peak_deviatoric_stress_MPa", row.peak, "MPa");
+      w.finish(row.completes ? notebook::RunStatus::Completed : notebook::RunStatus::Failed);
+      ids.push_back(w.id());
+      nb.db().exec("UPDATE runs SET wall_seconds = " + std::to_string(row.seconds) +
+                   " WHERE id = " + std::to_string(w.id()));
+    }
+  }
+  const Study s = evaluateStudy(lab, ids, 0.05);
+  EXPECT_EQ(s.varied, std::vector<std::string>{"numerics.timestep_safety"});
+  ASSERT_EQ(s.points.size(), 5u);
+  EXPECT_DOUBLE_EQ(s.points[0].error, 0.0);
+  EXPECT_NEAR(s.points[1].error, 0.02, 1e-12);
+  EXPECT_NEAR(s.points[3].error, 0.08, 1e-12);
+  EXPECT_TRUE(std::isinf(s.points[4].error));  // failed: no error to trade
+  EXPECT_TRUE(s.points[0].pareto);
+  EXPECT_TRUE(s.points[1].pareto);
+  EXPECT_FALSE(s.points[2].pareto);
+  EXPECT_TRUE(s.points[3].pareto);
+  EXPECT_FALSE(s.points[4].pareto);
+  EXPECT_EQ(s.cheapest, 1);  // 0.4: 40 s, within 5%
+  EXPECT_NE(studySummary(s).find("numerics.timestep_safety = 0.4"), std::string::npos)
+      << studySummary(s);
+  EXPECT_EQ(evaluateStudy(lab, ids, 0.10).cheapest, 3);  // 8% is within 10%
+
+  // The report: the page names the cheapest setting, the chart's data hold the Pareto front
+  // in order of time, the table every run.
+  const std::string out = lab + ".report";
+  writeStudyReport(s, out);
+  auto slurp = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string page = slurp(out + "/index.html");
+  EXPECT_NE(page.find("Cheapest within 5%:</strong> run " + std::to_string(ids[1])),
+            std::string::npos);
+  EXPECT_NE(page.find("2.5&times; faster"), std::string::npos);
+  EXPECT_NE(page.find("cost-accuracy.png"), std::string::npos);
+  const std::string chart = slurp(out + "/cost-accuracy.csv");
+  EXPECT_NE(chart.find("1,Pareto front,20,8\n1,Pareto front,40,2\n1,Pareto front,100,0\n"),
+            std::string::npos)
+      << chart;
+  EXPECT_GT(std::filesystem::file_size(out + "/cost-accuracy.png"), 5000u);
+  const std::string table = slurp(out + "/study.csv");
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 6);  // header and five runs
+  std::filesystem::remove_all(out);
+  for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(lab + ext);
+}
+
+}  // namespace
+}  // namespace rocklab::reports
