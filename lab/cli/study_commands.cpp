@@ -85,17 +85,27 @@ Reference readReference(const std::string& path) {
     // Ordered by name, so that a check lists them the same way every time.
     const auto root = toml::parse<toml::discard_comments, std::map, std::vector>(path);
     r.protocol = toml::find<std::string>(root, "protocol");
-    for (const auto& [name, v] : toml::find(root, "results").as_table()) {
-      Reference::Key k;
-      k.name = name;
-      k.value = toml::find<double>(v, "value");
-      k.tolerance = toml::find<double>(v, "tolerance");
-      k.unit = toml::find_or<std::string>(v, "unit", "");
-      if (!(k.tolerance >= 0.0)) {
-        throw std::invalid_argument("results." + name + ".tolerance must be >= 0");
+    // A prefixed name ("stage1.vp_z") is written quoted; unquoted, TOML reads it as nested
+    // tables, which are walked down to the entries that hold a value.
+    auto walk = [&](auto&& self, const auto& table, const std::string& prefix) -> void {
+      for (const auto& [key, v] : table) {
+        if (!v.is_table()) continue;
+        if (!v.contains("value")) {
+          self(self, v.as_table(), prefix + key + ".");
+          continue;
+        }
+        Reference::Key k;
+        k.name = prefix + key;
+        k.value = toml::find<double>(v, "value");
+        k.tolerance = toml::find<double>(v, "tolerance");
+        k.unit = toml::find_or<std::string>(v, "unit", "");
+        if (!(k.tolerance >= 0.0)) {
+          throw std::invalid_argument("results." + k.name + ".tolerance must be >= 0");
+        }
+        r.keys.push_back(k);
       }
-      r.keys.push_back(k);
-    }
+    };
+    walk(walk, toml::find(root, "results").as_table(), "");
   } catch (const std::exception& e) {
     throw std::invalid_argument(path + ": not a reference file: " + e.what());
   }
@@ -306,7 +316,8 @@ int regressUpdate(const RegressUpdateOptions& o) {
       }
       const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
       const double tolerance = std::max(2.0 * (*hi - *lo), 0.01 * std::abs(v.front()));
-      file << "\n[results." << key << "]\nvalue = " << fmt(v.front())
+      const std::string quoted = key.find('.') == std::string::npos ? key : "\"" + key + "\"";
+      file << "\n[results." << quoted << "]\nvalue = " << fmt(v.front())
            << "\ntolerance = " << fmt(tolerance) << "\nunit = \""
            << reports::findKeyResult(c.rig->name, key)->unit << "\"\nseeds = [";
       for (std::size_t k = 0; k < v.size(); ++k) file << (k ? ", " : "") << fmt(v[k]);

@@ -436,8 +436,9 @@ TEST(Protocols, AccuracyStudyRunsTheLadderAndReportsIt) {
       << out;
   EXPECT_NE(out.find("cheapest within 50%: run "), std::string::npos) << out;
   nb::Notebook n(lab.path);
-  EXPECT_EQ(scalar(n, "SELECT group_concat(value, ' ') FROM (SELECT value FROM params WHERE key = "
-                      "'flow.retriangulate_displacement_radii' ORDER BY run_id)"),
+  EXPECT_EQ(scalar(n,
+                   "SELECT group_concat(value, ' ') FROM (SELECT value FROM params WHERE key = "
+                   "'flow.retriangulate_displacement_radii' ORDER BY run_id)"),
             "0.25 2");
   EXPECT_EQ(scalar(n, "SELECT count(*) FROM runs WHERE status = 'completed'"), "2");
   std::ifstream page(out_dir + "/index.html");
@@ -461,6 +462,7 @@ TEST(Protocols, RegressCheckFailsAKeyResultMovedBeyondItsTolerance) {
     info.rig = "biaxial";
     nb::RunWriter w(n, info, {{"protocol.key_results", "[\"ucs_MPa\"]", ""}});
     w.result("ucs_MPa", 9.8, "MPa");
+    w.result("test2.ucs_MPa", 7.0, "MPa");
     w.finish(nb::RunStatus::Completed);
   }
   auto check = [&](const std::string& results) {
@@ -481,6 +483,13 @@ TEST(Protocols, RegressCheckFailsAKeyResultMovedBeyondItsTolerance) {
       "[results.band_angle_deg]\nvalue = 30.0\ntolerance = 5.0\n");
   EXPECT_EQ(code, 1) << out;
   EXPECT_NE(out.find("FAIL band_angle_deg = not recorded"), std::string::npos) << out;
+  // A prefixed name, quoted as written or unquoted (TOML's nested tables).
+  for (const char* name : {"\"test2.ucs_MPa\"", "test2.ucs_MPa"}) {
+    std::tie(code, out) =
+        check(std::string("[results.") + name + "]\nvalue = 9.0\ntolerance = 0.5\n");
+    EXPECT_EQ(code, 1) << out;
+    EXPECT_NE(out.find("FAIL test2.ucs_MPa = 7.0"), std::string::npos) << out;
+  }
   std::tie(code, out) = check("[results.ucs_MPa]\nvalue = 9.8\n");  // no tolerance
   EXPECT_EQ(code, 2) << out;
 }
