@@ -16,25 +16,12 @@ Value recorded(const RunData& r, const KeyResultDef& d, const std::string& prefi
   return it->second.value;
 }
 
-// Cement breaks of both modes (the biaxial rig records them apart).
-Value brokenBonds(const RunData& r, const KeyResultDef&, const std::string& prefix) {
-  auto t = r.results.find(prefix + "broken_bonds_tensile");
-  auto s = r.results.find(prefix + "broken_bonds_shear");
-  if (t == r.results.end() || s == r.results.end()) return std::nullopt;
-  return t->second.value + s->second.value;
-}
-
 // A count of broken bonds (the definition's source, prefixed) over the bonds the sample was
 // cemented with: intensive, so that samples of different sizes compare (a resolution study).
 Value brokenFraction(const RunData& r, const KeyResultDef& d, const std::string& prefix) {
   auto installed = r.results.find("bonds_installed");
   if (installed == r.results.end() || !(installed->second.value > 0.0)) return std::nullopt;
-  Value broken;
-  if (d.source == "broken_bonds_total" && !r.results.count(prefix + d.source)) {
-    broken = brokenBonds(r, d, prefix);  // the biaxial rig records the two modes apart
-  } else {
-    broken = recorded(r, d, prefix);
-  }
+  const Value broken = recorded(r, d, prefix);
   if (!broken) return std::nullopt;
   return *broken / installed->second.value;
 }
@@ -142,8 +129,7 @@ std::vector<KeyResultDef> biaxialDefs() {
       rec("critical_deviatoric_stress_MPa", "MPa",
           "deviatoric stress at the critical point (peak or onset of compactive yield)"),
       rec("band_angle_deg", "deg", "angle between the localisation band and sigma_1"),
-      {"broken_bonds_total", "-", "cement bonds broken during the loading, both modes", brokenBonds,
-       "", "", 0.0, 0.0},
+      rec("broken_bonds_total", "-", "cement bonds broken during the loading, both modes"),
       {"broken_bond_fraction", "-",
        "cement bonds broken during the loading over those installed (compares sample sizes)",
        brokenFraction, "broken_bonds_total", "", 0.0, 0.0},

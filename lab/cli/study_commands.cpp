@@ -12,7 +12,6 @@
 
 #include "lab/cli/build_info.hpp"
 #include "lab/cli/lab_commands.hpp"
-#include "lab/notebook/queries.hpp"
 #include "reports/key_results.hpp"
 #include "reports/run_data.hpp"
 #include "reports/study.hpp"

@@ -222,6 +222,8 @@ TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
   put("volumetric_strain_final", frame.volumetricStrain(), "");
   put("broken_bonds_tensile", static_cast<double>(sp.broken(BondBreakMode::Tensile)), "");
   put("broken_bonds_shear", static_cast<double>(sp.broken(BondBreakMode::Shear)), "");
+  put("broken_bonds_total",
+      static_cast<double>(sp.broken(BondBreakMode::Tensile) + sp.broken(BondBreakMode::Shear)), "");
   if (sp.grain_kind) {
     put("broken_grain_bonds_tensile",
         static_cast<double>(sp.brokenInGrains(BondBreakMode::Tensile)), "");

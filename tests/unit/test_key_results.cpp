@@ -40,8 +40,7 @@ RunData biaxialRun() {
   addSeries(r, "axial_strain", eps);
   addSeries(r, "deviatoric_stress_MPa", q);
   r.results["peak_deviatoric_stress_MPa"] = {30.0, "MPa"};
-  r.results["broken_bonds_tensile"] = {12.0, ""};
-  r.results["broken_bonds_shear"] = {5.0, ""};
+  r.results["broken_bonds_total"] = {17.0, ""};
   r.params.emplace_back("protocol.key_results",
                         R"(["peak_deviatoric_stress_MPa", "deviatoric_stress_at_1pct_strain_MPa", )"
                         R"("tangent_modulus_at_1pct_strain_MPa", "secant_modulus_50_MPa", )"
@@ -60,12 +59,12 @@ TEST(KeyResults, EachDefinitionReadsWhatItSays) {
   EXPECT_NEAR(*k[1].value, 10.0, 1e-9);    // interpolated at 1% strain
   EXPECT_NEAR(*k[2].value, 1000.0, 1e-6);  // the local slope
   EXPECT_NEAR(*k[3].value, 1000.0, 1e-6);  // 15 MPa at 1.5% strain
-  EXPECT_DOUBLE_EQ(*k[4].value, 17.0);     // both modes
+  EXPECT_DOUBLE_EQ(*k[4].value, 17.0);
   EXPECT_FALSE(evaluateKeyResult(r, "broken_bond_fraction").has_value());  // none installed
   RunData cemented = r;
   cemented.results["bonds_installed"] = {68.0, ""};
   EXPECT_DOUBLE_EQ(*evaluateKeyResult(cemented, "broken_bond_fraction"), 0.25);
-  EXPECT_FALSE(k[5].value.has_value());    // no band recorded: missing, not zero
+  EXPECT_FALSE(k[5].value.has_value());  // no band recorded: missing, not zero
 }
 
 TEST(KeyResults, PrefixesPickATestACopyOrAStage) {
