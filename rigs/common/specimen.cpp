@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <sstream>
 
@@ -276,6 +277,7 @@ Specimen<D> Specimen<D>::branch() const {
   b.density = density;
   b.cement_kind = cement_kind;
   b.cement = cement;
+  b.cement_reference = cement_reference;
   b.grain_kind = grain_kind;
   b.grain_bonds = grain_bonds;
   b.grain_aspect_ratios = grain_aspect_ratios;
@@ -307,12 +309,30 @@ std::size_t Specimen<D>::crushedGrains() const {
 }
 
 template <int D>
+BondOrientations bondOrientations(const Simulation<D>& sim, std::uint8_t kind, int axis) {
+  // |cos| of the angle to the axis: above cos 30 deg axial, below cos 60 deg lateral.
+  const double axial_cos = std::cos(std::numbers::pi / 6), lateral_cos = 0.5;
+  const auto& P = sim.particles();
+  const auto& B = sim.bonds();
+  BondOrientations n;
+  for (std::size_t b = 0; b < B.size(); ++b) {
+    if (B.kind[b] != kind) continue;
+    const Vec<D> d = P.pos[B.j[b]] - P.pos[B.i[b]];
+    const double c = std::abs(d[axis]) / d.norm();
+    n.axial += c >= axial_cos ? 1 : 0;
+    n.lateral += c <= lateral_cos ? 1 : 0;
+  }
+  return n;
+}
+
+template <int D>
 void Specimen<D>::resetBrokenCount() {
   for (int m = 0; m < 2; ++m) {
     const auto mode = m == 0 ? BondBreakMode::Tensile : BondBreakMode::Shear;
     if (cement_kind) broken_offset[m] = sim->brokenBonds(*cement_kind, mode);
     if (grain_kind) broken_offset[2 + m] = sim->brokenBonds(*grain_kind, mode);
   }
+  if (cement_kind) cement_reference = bondOrientations(*sim, *cement_kind, kAxial);
   if (grain_kind) {
     fragments_reference = grainFragments<D>(sim->particles(), sim->bonds(), sim->bondKinds());
   }
@@ -655,6 +675,17 @@ void recordState(Specimen<D>& sp, Recorder& rec, const std::string& prefix,
   put("broken_bonds_tensile", tensile);
   put("broken_bonds_shear", shear);
   put("broken_bonds_total", tensile + shear);
+  if (sp.cement_kind) {
+    // Which cement broke, by orientation (BondOrientations): the fraction of each class
+    // intact at the stage's start that has broken since.
+    const BondOrientations now = bondOrientations(sim, *sp.cement_kind, ax);
+    const BondOrientations& ref = sp.cement_reference;
+    auto broken = [](std::size_t intact, std::size_t reference) {
+      return 1.0 - static_cast<double>(intact) / static_cast<double>(reference);
+    };
+    if (ref.axial > 0) put("broken_fraction_axial_bonds", broken(now.axial, ref.axial));
+    if (ref.lateral > 0) put("broken_fraction_lateral_bonds", broken(now.lateral, ref.lateral));
+  }
   if (sp.grain_kind) {
     put("broken_grain_bonds_tensile",
         static_cast<double>(sp.brokenInGrains(BondBreakMode::Tensile)));
@@ -685,6 +716,8 @@ template void recordState<2>(Specimen<2>&, Recorder&, const std::string&, const 
 template void recordState<3>(Specimen<3>&, Recorder&, const std::string&, const std::string&,
                              double);
 template void recordBreaks<2>(Specimen<2>&, Recorder&, const std::string&);
+template BondOrientations bondOrientations<2>(const Simulation<2>&, std::uint8_t, int);
+template BondOrientations bondOrientations<3>(const Simulation<3>&, std::uint8_t, int);
 template void snapshot<2>(Specimen<2>&, const Settings&, Recorder&, const std::string&,
                           const std::string&);
 template void snapshot<3>(Specimen<3>&, const Settings&, Recorder&, const std::string&,

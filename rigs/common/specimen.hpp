@@ -36,6 +36,16 @@ void byDimension(const Settings& s, Body&& body) {
   }
 }
 
+// Intact bonds of one kind by their orientation to the sigma_1 axis: within 30 degrees of
+// it ("axial" bonds: their breaks open cracks across the axis) and within 30 degrees of the
+// plane normal to it ("lateral" bonds: cracks along the axis, which slow the waves that
+// cross it; Li & Holt section 4.2 explain Figure 18b's anisotropy by which of them fail).
+struct BondOrientations {
+  std::size_t axial = 0, lateral = 0;
+};
+template <int D>
+BondOrientations bondOrientations(const Simulation<D>& sim, std::uint8_t kind, int axis);
+
 template <int D>
 struct Specimen {
   std::unique_ptr<Simulation<D>> sim;
@@ -57,6 +67,7 @@ struct Specimen {
   // cement tensile, shear, then grain tensile, shear; likewise the grains' fragments.
   std::uint64_t broken_offset[4] = {0, 0, 0, 0};
   std::vector<std::uint32_t> fragments_reference;
+  BondOrientations cement_reference;  // intact cement at the measured stage's start
   // Positions of the breaks handed to the notebook while this is on (localisation).
   bool keep_break_positions = false;
   std::vector<std::array<double, 3>> break_positions;

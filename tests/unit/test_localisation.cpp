@@ -1,4 +1,5 @@
-// The band detector on synthetic damage: a band of known angle in a uniform background.
+// The band detector on synthetic damage: a band of known angle in a uniform background; and
+// bonds counted by their orientation to sigma_1.
 
 #include <gtest/gtest.h>
 
@@ -8,6 +9,8 @@
 
 #include "lab/core/random.hpp"
 #include "rigs/common/localisation.hpp"
+#include "rigs/common/specimen.hpp"
+#include "tests/support.hpp"
 
 namespace rocklab::rigs {
 namespace {
@@ -145,6 +148,39 @@ TEST(StrainField, TheMostCompactedParticlesLieInTheCompactionBand) {
   const Band b = findBand(pts, 2, 1, 0.001);
   EXPECT_NEAR(b.angle_to_axial_deg, 90.0, 2.0);
   EXPECT_TRUE(b.is_compaction());
+}
+
+// Bonds by orientation to sigma_1 (the damage anisotropy of Li & Holt Figure 18b): five
+// bonded pairs of spheres, far apart, at 0, 20, 45, 70 and 90 degrees from the z axis; 0
+// and 20 are axial (within 30 degrees of the axis), 70 and 90 lateral, 45 neither; another
+// kind's bonds are not counted.
+TEST(BondOrientations, CountsBondsNearTheAxisAndNearItsNormalPlane) {
+  Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), {});
+  ParticleSpec<3> p;
+  p.radius = 1e-3;
+  p.density = 2650.0;
+  double x = 0.0;
+  for (const double deg : {0.0, 20.0, 45.0, 70.0, 90.0}) {
+    p.position = Eigen::Vector3d(x, 0.0, 0.0);
+    sim.particles().add(p);
+    p.position += 2e-3 * Eigen::Vector3d(std::sin(deg * kDeg), 0.0, std::cos(deg * kDeg));
+    sim.particles().add(p);
+    x += 10e-3;
+  }
+  BondKind cement;
+  cement.modulus = 1e9;
+  cement.tensile_mean = cement.shear_mean = 1e6;
+  const std::uint8_t kind = sim.addBondKind(cement);
+  ASSERT_EQ(sim.cement(kind, 0.01).installed, 5u);
+  const BondOrientations n = bondOrientations(sim, kind, 2);
+  EXPECT_EQ(n.axial, 2u);
+  EXPECT_EQ(n.lateral, 2u);
+  // About the x axis instead, 90 and 70 are axial and 0 and 20 lateral.
+  const BondOrientations about_x = bondOrientations(sim, kind, 0);
+  EXPECT_EQ(about_x.axial, 2u);
+  EXPECT_EQ(about_x.lateral, 2u);
+  cement.name = "other";
+  EXPECT_EQ(bondOrientations(sim, sim.addBondKind(cement), 2).axial, 0u);
 }
 
 }  // namespace
