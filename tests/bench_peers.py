@@ -3,8 +3,10 @@
 
 Not part of `make test`: timings are not assertions. Runs rocklab and LIGGGHTS alternately
 on the same packing, on one core and on two, at least three times each, and prints the
-medians and their ratios (the issue's targets: rocklab >= 1.5x LIGGGHTS on one core, and
-rocklab on two threads >= 1.8x its own one-core figure).
+medians and their ratios (the issue's targets: rocklab >= 1.5x LIGGGHTS on one core,
+rocklab on two threads >= 1.8x its own one-core figure, and the bonded variant of the scene
+>= 0.6x the unbonded one on one core; the bonded runs alternate with the others, and the
+bonded scene's hash is checked once with the bonds one at a time, `--scalar-bonds`).
 
 usage: tests/bench_peers.py [--runs N] [--rocklab PATH] [--steps S] PACKING [PACKING ...]
 e.g.   tests/bench_peers.py ../shared/peers/packing_10k.txt ../shared/peers/packing_50k.txt
@@ -37,9 +39,9 @@ def ensure_liggghts():
                            "liggghts", "openmpi-bin"], check=True)
 
 
-def rocklab_rate(rocklab, packing, threads, steps):
+def rocklab_rate(rocklab, packing, threads, steps, extra=()):
     out = subprocess.run([rocklab, "bench", "--packing", packing, "--threads", str(threads),
-                          "--steps", str(steps), "--json"],
+                          "--steps", str(steps), "--json", *extra],
                          check=True, capture_output=True, text=True).stdout
     run = json.loads(out)["runs"][0]
     return run["particle_steps_per_second"], run["state_hash"]
@@ -78,7 +80,7 @@ def main():
             lig_dir = os.path.join(tmp, "lig")
             subprocess.run([sys.executable, os.path.join(PEERS, "make_liggghts_input.py"),
                             packing, lig_dir], check=True, capture_output=True)
-            r1, r2, l1, l2, hashes = [], [], [], [], set()
+            r1, r2, l1, l2, rb, hashes, bonded_hashes = [], [], [], [], [], set(), set()
             for k in range(a.runs):
                 # Alternate the codes so a slow spell of the machine hits both.
                 l1.append(liggghts_rate(lig_dir, 1, a.steps))
@@ -89,19 +91,27 @@ def main():
                 rate, h = rocklab_rate(a.rocklab, packing, 2, a.steps)
                 r2.append(rate)
                 hashes.add(h)
+                rate, h = rocklab_rate(a.rocklab, packing, 1, a.steps, ["--bonded"])
+                rb.append(rate)
+                bonded_hashes.add(h)
                 print(f"{os.path.basename(packing)} run {k + 1}: LIGGGHTS {l1[-1]:.3e} / "
-                      f"{l2[-1]:.3e}, rocklab {r1[-1]:.3e} / {r2[-1]:.3e} (1 / 2 cores)",
-                      file=sys.stderr)
+                      f"{l2[-1]:.3e}, rocklab {r1[-1]:.3e} / {r2[-1]:.3e} (1 / 2 cores), "
+                      f"bonded {rb[-1]:.3e} (1 core)", file=sys.stderr)
+            bonded_hashes.add(rocklab_rate(a.rocklab, packing, 1, a.steps,
+                                           ["--bonded", "--scalar-bonds"])[1])
             med = {n: statistics.median(v) for n, v in
-                   (("l1", l1), ("l2", l2), ("r1", r1), ("r2", r2))}
-            rows.append((os.path.basename(packing), med, len(hashes) == 1))
+                   (("l1", l1), ("l2", l2), ("r1", r1), ("r2", r2), ("rb", rb))}
+            same = len(hashes) == 1 and len(bonded_hashes) == 1
+            rows.append((os.path.basename(packing), med, same))
     print(f"medians of {a.runs} alternating runs, particle-steps/s ({a.steps} timed steps)")
     print(f"{'packing':<18}{'LIGGGHTS 1':>12}{'rocklab 1':>12}{'ratio':>7}"
-          f"{'LIGGGHTS 2':>12}{'rocklab 2':>12}{'ratio':>7}{'rocklab 2/1':>13}  same hash")
+          f"{'LIGGGHTS 2':>12}{'rocklab 2':>12}{'ratio':>7}{'rocklab 2/1':>13}"
+          f"{'bonded 1':>12}{'bonded/1':>10}  same hash")
     for name, m, same in rows:
         print(f"{name:<18}{m['l1']:>12.3e}{m['r1']:>12.3e}{m['r1'] / m['l1']:>7.2f}"
               f"{m['l2']:>12.3e}{m['r2']:>12.3e}{m['r2'] / m['l2']:>7.2f}"
-              f"{m['r2'] / m['r1']:>13.2f}  {'yes' if same else 'NO'}")
+              f"{m['r2'] / m['r1']:>13.2f}{m['rb']:>12.3e}{m['rb'] / m['r1']:>10.2f}"
+              f"  {'yes' if same else 'NO'}")
 
 
 if __name__ == "__main__":

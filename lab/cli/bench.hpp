@@ -24,6 +24,7 @@ struct BenchOptions {
   bool energy = false;               // track contact dissipation (LIGGGHTS does not)
   std::string save_packing;          // write the generated packing here
   std::array<int, 3> tile{1, 1, 1};  // copies of the packing along x, y, z (a larger scene)
+  bool scalar_bonds = false;         // bonds one at a time, not four per AVX register (same bits)
   bool bonded = false;               // a parallel bond on every initial contact (cemented rock)
   bool flow = false;                 // also time the pore network and a steady solve on the packing
   bool render = false;               // also time an off-screen snapshot of the packing

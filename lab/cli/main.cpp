@@ -149,6 +149,8 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::Range(1, 1000));
   b->add_flag("--bonded", bench.bonded, "A parallel bond on every initial contact");
+  b->add_flag("--scalar-bonds", bench.scalar_bonds,
+              "Bonds one at a time instead of four per AVX register (the same bits, slower)");
   b->add_flag("--flow", bench.flow,
               "Time the pore network (triangulation, network, steady solve) instead");
   b->add_flag("--render", bench.render,

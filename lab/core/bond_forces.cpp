@@ -1,5 +1,6 @@
 #include "lab/core/bond_forces.hpp"
 
+#include "lab/core/bond_lanes.hpp"
 #include "lab/core/contact_model.hpp"
 #include "lab/core/errors.hpp"
 
@@ -68,53 +69,81 @@ void BondForces<D>::compute(BondPass<D>& pass) {
     if (!adjacency_valid_) buildAdjacency(P.size(), B);
   }
 
+  // A bond's outcome, the same from either path: at or past its strength it breaks now and
+  // carries nothing more (the larger ratio of stress to strength names the mode when both
+  // are reached); else its force and torques go to its particles (threaded: to its slots).
+  auto settle = [&](std::size_t blk, std::size_t b, const Vec<D>& force, const Ang<D>& ti,
+                    const Ang<D>& tj, double tensile_stress, double shear_stress)
+      __attribute__((always_inline)) {
+    if (pass.breakable && (tensile_stress >= B.tensile[b] || shear_stress >= B.shear[b])) {
+      const double rt = tensile_stress / B.tensile[b], rs = shear_stress / B.shear[b];
+      const bool tensile =
+          tensile_stress >= B.tensile[b] && (shear_stress < B.shear[b] || rt >= rs);
+      block_broken_[blk].push_back(static_cast<std::uint32_t>(b));
+      block_modes_[blk].push_back({tensile ? BondBreakMode::Tensile : BondBreakMode::Shear,
+                                   tensile ? tensile_stress : shear_stress});
+      if (pass.threaded) active_[b] = 0;
+      return;
+    }
+    const std::uint32_t i = B.i[b], j = B.j[b];
+    if (pass.threaded) {
+      active_[b] = 1;
+      force_[b] = force;
+      torque_i_[b] = ti;
+      torque_j_[b] = tj;
+    } else {
+      P.force[i] -= force;
+      P.force[j] += force;
+      P.torque[i] -= ti;  // ti is subtracted from i
+      P.torque[j] += tj;
+    }
+  };
+  auto one = [&](std::size_t blk, std::size_t b) {
+    const std::uint32_t i = B.i[b], j = B.j[b];
+    const Vec<D> d = P.pos[j] - P.pos[i];
+    const double dist = d.norm();
+    BondKinematics<D> k;
+    k.n = d / dist;
+    const double overlap = P.radius[i] + P.radius[j] - dist;  // < 0: a gap
+    const double li = P.radius[i] - 0.5 * overlap, lj = P.radius[j] - 0.5 * overlap;
+    k.vc = P.vel[j] - P.vel[i] - cross(Ang<D>(lj * P.spin[j] + li * P.spin[i]), k.n);
+    k.dspin = P.spin[j] - P.spin[i];
+    if constexpr (D == 3) {
+      k.spin_n = 0.5 * spinAbout(Ang<D>(P.spin[i] + P.spin[j]), k.n);
+    } else {
+      k.spin_n = 0.0;
+    }
+    const auto section = BondSection<D>::of(B.radius[b], P.thickness);
+    const BondResult<D> r = bondForce<D>(section, B.kn[b], B.ks[b], k, B.load[b], dt);
+    const Ang<D> ncf = cross(k.n, B.load[b].fs);
+    settle(blk, b, r.force, li * ncf + r.moment, r.moment - lj * ncf, r.tensile, r.shear);
+  };
+
 #pragma omp parallel for schedule(dynamic, 1) num_threads(pass.threads) if (pass.threaded)
   for (std::size_t blk = 0; blk < blocks; ++blk) {
     const std::size_t end = std::min(nb, (blk + 1) * kBlockRows);
-    for (std::size_t b = blk * kBlockRows; b < end; ++b) {
-      const std::uint32_t i = B.i[b], j = B.j[b];
-      const Vec<D> d = P.pos[j] - P.pos[i];
-      const double dist = d.norm();
-      BondKinematics<D> k;
-      k.n = d / dist;
-      const double overlap = P.radius[i] + P.radius[j] - dist;  // < 0: a gap
-      const double li = P.radius[i] - 0.5 * overlap, lj = P.radius[j] - 0.5 * overlap;
-      k.vc = P.vel[j] - P.vel[i] - cross(Ang<D>(lj * P.spin[j] + li * P.spin[i]), k.n);
-      k.dspin = P.spin[j] - P.spin[i];
-      if constexpr (D == 3) {
-        k.spin_n = 0.5 * spinAbout(Ang<D>(P.spin[i] + P.spin[j]), k.n);
-      } else {
-        k.spin_n = 0.0;
-      }
-      const auto section = BondSection<D>::of(B.radius[b], P.thickness);
-      const BondResult<D> r = bondForce<D>(section, B.kn[b], B.ks[b], k, B.load[b], dt);
-
-      // A bond at or past its strength breaks now and carries nothing more (the larger
-      // ratio of stress to strength names the mode when both are reached).
-      const double rt = r.tensile / B.tensile[b], rs = r.shear / B.shear[b];
-      if (pass.breakable && (r.tensile >= B.tensile[b] || r.shear >= B.shear[b])) {
-        const bool tensile = r.tensile >= B.tensile[b] && (r.shear < B.shear[b] || rt >= rs);
-        block_broken_[blk].push_back(static_cast<std::uint32_t>(b));
-        block_modes_[blk].push_back({tensile ? BondBreakMode::Tensile : BondBreakMode::Shear,
-                                     tensile ? r.tensile : r.shear});
-        if (pass.threaded) active_[b] = 0;
-        continue;
-      }
-      const Ang<D> ncf = cross(k.n, B.load[b].fs);
-      const Ang<D> ti = li * ncf + r.moment;  // subtracted from i
-      const Ang<D> tj = r.moment - lj * ncf;  // added to j
-      if (pass.threaded) {
-        active_[b] = 1;
-        force_[b] = r.force;
-        torque_i_[b] = ti;
-        torque_j_[b] = tj;
-      } else {
-        P.force[i] -= r.force;
-        P.force[j] += r.force;
-        P.torque[i] -= ti;
-        P.torque[j] += tj;
+    std::size_t b = blk * kBlockRows;
+    if constexpr (D == 3) {
+      if (pass.lanes && lanes::available()) {
+        // Each group is settled after the next one is computed: its results are ready by
+        // then, and its scalar scatter overlaps the tail of the next group's chain.
+        lanes::Settled s[2];
+        auto settleFour = [&](std::size_t first, const lanes::Settled& r) {
+          for (int k = 0; k < 4; ++k) {
+            settle(blk, first + k, Vec<3>(r.force[0][k], r.force[1][k], r.force[2][k]),
+                   Ang<3>(r.ti[0][k], r.ti[1][k], r.ti[2][k]),
+                   Ang<3>(r.tj[0][k], r.tj[1][k], r.tj[2][k]), r.tensile[k], r.shear[k]);
+          }
+        };
+        const std::size_t first = b;
+        for (; b + 4 <= end; b += 4) {
+          lanes::fourBonds(P, B, b, dt, s[(b / 4) & 1]);
+          if (b > first) settleFour(b - 4, s[((b - 4) / 4) & 1]);
+        }
+        if (b > first) settleFour(b - 4, s[((b - 4) / 4) & 1]);
       }
     }
+    for (; b < end; ++b) one(blk, b);  // 2D, no AVX, or the block's last few bonds
   }
 
   if (pass.threaded) {

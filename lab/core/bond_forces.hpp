@@ -24,6 +24,8 @@ struct BondPass {
   std::vector<std::uint32_t> broken;
   std::vector<BondBreakMode> modes;
   std::vector<double> stresses;
+
+  bool lanes = true;  // 3D: four bonds per AVX register where the CPU has it (same bits)
 };
 
 template <int D>

@@ -333,7 +333,8 @@ template <int D>
 void Simulation<D>::computeBondForces(double dt) {
   const auto t0 = std::chrono::steady_clock::now();
   auto& P = particles_;
-  BondPass<D> pass{P, bonds_, dt, threaded(), config_.threads, config_.bond_breakage, {}, {}, {}};
+  BondPass<D> pass{P,  bonds_, dt, threaded(),        config_.threads, config_.bond_breakage,
+                   {}, {},     {}, config_.bond_lanes};
   bond_forces_.compute(pass);
   if (!pass.broken.empty()) {
     // Second phase: log and remove the broken bonds in bond order.
