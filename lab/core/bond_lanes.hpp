@@ -11,8 +11,8 @@
 // (-ffp-contract=off, no FMA target). So a bond gets the same bits in a lane as on the
 // scalar path, and the benchmark's state hash holds. Where the scalar code branches, both
 // sides are computed and each lane takes its own with a mask. Keep the two in step: a
-// change to the scalar formulas must be made here too (test_determinism.cpp compares the
-// two bit for bit on a sample whose bonds start unloaded, hold gaps and break).
+// change to the scalar formulas must be made here too (test_bonds.cpp and
+// test_determinism.cpp compare the two bit for bit on samples whose bonds break).
 //
 // The functions carry the AVX target themselves (the rest of the binary stays x86-64
 // baseline); BondForces calls them only when the CPU has AVX (lanes::available()).

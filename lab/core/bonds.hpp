@@ -104,6 +104,7 @@ struct BondResult {
 // (dFn = kn A d(approach), dFs = -ks A vt dt, dMb = -kn I dtheta_b, dMt = -ks J dtheta_t)
 // and returns the load and the peripheral stresses
 // sigma = -Fn / A + |Mb| R / I, tau = |Fs| / A + |Mt| R / J (Potyondy & Cundall 2004, eq. 7).
+// bond_lanes.hpp repeats these operations, in this order, four bonds at a time.
 template <int D>
 inline BondResult<D> bondForce(const BondSection<D>& s, double kn, double ks,
                                const BondKinematics<D>& k, BondLoad<D>& b, double dt) {

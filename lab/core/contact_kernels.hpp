@@ -76,7 +76,8 @@ struct ContactKinematics {
 // Keeps a vector stored with a contact (a spring force, a bond moment) in the contact's
 // tangent plane as the contact turns: turned with the bodies' mean spin about the normal,
 // then projected on the new tangent plane with its magnitude kept (Cundall & Strack 1979;
-// cf. Yade ScGeom::rotate). First order in the angle turned per step.
+// cf. Yade ScGeom::rotate). First order in the angle turned per step. bond_lanes.hpp repeats
+// it, in this order, four bonds at a time.
 template <int D>
 inline void followContactFrame(Vec<D>& v, const Vec<D>& n, double spin_n, double dt) {
   const double m2 = v.squaredNorm();
