@@ -215,6 +215,7 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
     cement.modulus = kBondModulus;
     cement.tensile_mean = cement.shear_mean = kBondStrength;
     r.bonds = sim.cement(sim.addBondKind(cement), 0.0).installed;
+    r.bond_lanes = cfg.bond_lanes && bondLanesAvailable();
   }
   const Eigen::Vector3d extent = boxExtent(sim);
   for (int w = 0; w < 6; ++w) {
@@ -317,6 +318,7 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
           << ", \"wall_stress_start_Pa\": " << r.wall_stress_start
           << ", \"wall_stress_end_Pa\": " << r.wall_stress_end << ", \"rebuilds\": " << r.rebuilds
           << ", \"listed_pairs\": " << r.listed_pairs << ", \"bonds\": " << r.bonds
+          << ", \"bond_lanes\": " << (r.bond_lanes ? "true" : "false")
           << ", \"peak_rss_bytes\": " << r.peak_rss_bytes << ", \"state_hash\": \"" << std::hex
           << r.state_hash << std::dec << "\"}" << (k + 1 < results.size() ? "," : "") << "\n";
     }
@@ -342,8 +344,10 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
   }
   if (!results.empty()) {
     out << "rocklab bench: " << source << ", Hertz-Mindlin"
-        << (results.front().bonds > 0 ? " + parallel bonds" : "") << ", dt = " << kTimeStep
-        << " s\n";
+        << (results.front().bonds == 0   ? ""
+            : results.front().bond_lanes ? " + parallel bonds (four per AVX register)"
+                                         : " + parallel bonds (one at a time)")
+        << ", dt = " << kTimeStep << " s\n";
     out << std::left << std::setw(8) << "threads" << std::setw(10) << "N" << std::setw(8) << "steps"
         << std::setw(11) << "seconds" << std::setw(20) << "particle-steps/s" << std::setw(9)
         << "Z start" << std::setw(7) << "Z end" << std::setw(20) << "wall stress (MPa)"

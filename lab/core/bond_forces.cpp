@@ -35,6 +35,10 @@ void BondStore<D>::removeFlagged(const std::vector<std::uint8_t>& broken) {
   ks.resize(out), tensile.resize(out), shear.resize(out), load.resize(out);
 }
 
+bool bondLanesAvailable() {
+  return lanes::available();
+}
+
 template <int D>
 void BondForces<D>::buildAdjacency(std::size_t particles, const BondStore<D>& bonds) {
   adjacency_row_.assign(particles + 1, 0);

@@ -28,6 +28,9 @@ struct BondPass {
   bool lanes = true;  // 3D: four bonds per AVX register where the CPU has it (same bits)
 };
 
+// Whether 3D bonds can run four per AVX register here (BondPass::lanes asks for it).
+bool bondLanesAvailable();
+
 template <int D>
 class BondForces {
  public:

@@ -71,8 +71,9 @@ TEST(Cli, BenchGivesTheSameStateOnOneAndTwoThreads) {
 }
 
 // The bench's larger and richer scenes (issue 9): mirrored tiles keep the packing's
-// structure, the bonded variant gives the same state on one and two threads, the pore
-// network and the snapshot are timed on the same packing.
+// structure, the bonded variant gives the same state on one and two threads and with the
+// bonds one at a time (`--scalar-bonds`), the pore network and the snapshot are timed on
+// the same packing.
 TEST(Cli, BenchVariantsTileBondFlowAndRender) {
   const std::string packing = std::string(ROCKLAB_SOURCE_DIR) + "/data/peers/packing_3k.txt";
   auto number = [](const std::string& text, const std::string& key) {
@@ -103,8 +104,17 @@ TEST(Cli, BenchVariantsTileBondFlowAndRender) {
        it != std::sregex_iterator(); ++it) {
     hashes.push_back((*it)[1]);
   }
-  ASSERT_EQ(hashes.size(), 2u);
+  const auto scalar = run("bench --packing " + packing +
+                          " --bonded --scalar-bonds --threads 1 --steps 20 --warmup 5 --json");
+  ASSERT_EQ(scalar.status, 0) << scalar.out;
+  EXPECT_NE(scalar.out.find("\"bond_lanes\": false"), std::string::npos) << scalar.out;
+  for (auto it = std::sregex_iterator(scalar.out.begin(), scalar.out.end(), hash);
+       it != std::sregex_iterator(); ++it) {
+    hashes.push_back((*it)[1]);
+  }
+  ASSERT_EQ(hashes.size(), 3u);
   EXPECT_EQ(hashes[0], hashes[1]);
+  EXPECT_EQ(hashes[0], hashes[2]);
 
   const auto flow = run("bench --packing " + packing + " --flow --json");
   ASSERT_EQ(flow.status, 0) << flow.out;
