@@ -1,5 +1,8 @@
 #include "lab/core/bond_forces.hpp"
 
+#include <cmath>
+#include <numbers>
+
 #include "lab/core/bond_lanes.hpp"
 #include "lab/core/contact_model.hpp"
 #include "lab/core/errors.hpp"
@@ -13,6 +16,8 @@ void BondKind::validate() const {
   requireRange(where, "radius_multiplier", radius_multiplier, 0.0, true, 10.0, false, "-");
   requireRange(where, "tensile_std", tensile_std, 0.0, false, INFINITY, true, "Pa");
   requireRange(where, "shear_std", shear_std, 0.0, false, INFINITY, true, "Pa");
+  requireRange(where, "friction_angle", friction_angle, 0.0, false, std::numbers::pi / 2, true,
+               "rad");
   // A mean at or below zero with Resample would loop for ever drawing a positive strength.
   const double lo = negative == NegativeStrength::Resample ? 0.0 : -INFINITY;
   requireRange(where, "tensile_mean", tensile_mean, lo, true, INFINITY, true, "Pa");
@@ -73,16 +78,33 @@ void BondForces<D>::compute(BondPass<D>& pass) {
     if (!adjacency_valid_) buildAdjacency(P.size(), B);
   }
 
+  tan_friction_.clear();
+  bool frictional = false;
+  if (pass.kinds) {
+    for (const BondKind& k : *pass.kinds) {
+      tan_friction_.push_back(std::tan(k.friction_angle));
+      frictional = frictional || k.friction_angle > 0.0;
+    }
+  }
+  // The shear strength c + sigma_n tan(phi) under a compressive normal stress sigma_n
+  // (BondKind::friction_angle); the bond's load is this step's, stored by either path.
+  auto shearStrength = [&](std::size_t b) {
+    if (!frictional) return B.shear[b];
+    const double sigma_n = B.load[b].fn / BondSection<D>::of(B.radius[b], P.thickness).area;
+    return sigma_n > 0.0 ? B.shear[b] + sigma_n * tan_friction_[B.kind[b]] : B.shear[b];
+  };
+
   // A bond's outcome, the same from either path: at or past its strength it breaks now and
   // carries nothing more (the larger ratio of stress to strength names the mode when both
   // are reached); else its force and torques go to its particles (threaded: to its slots).
   auto settle = [&](std::size_t blk, std::size_t b, const Vec<D>& force, const Ang<D>& ti,
                     const Ang<D>& tj, double tensile_stress, double shear_stress)
       __attribute__((always_inline)) {
-    if (pass.breakable && (tensile_stress >= B.tensile[b] || shear_stress >= B.shear[b])) {
-      const double rt = tensile_stress / B.tensile[b], rs = shear_stress / B.shear[b];
+    const double shear_strength = shearStrength(b);
+    if (pass.breakable && (tensile_stress >= B.tensile[b] || shear_stress >= shear_strength)) {
+      const double rt = tensile_stress / B.tensile[b], rs = shear_stress / shear_strength;
       const bool tensile =
-          tensile_stress >= B.tensile[b] && (shear_stress < B.shear[b] || rt >= rs);
+          tensile_stress >= B.tensile[b] && (shear_stress < shear_strength || rt >= rs);
       block_broken_[blk].push_back(static_cast<std::uint32_t>(b));
       block_modes_[blk].push_back({tensile ? BondBreakMode::Tensile : BondBreakMode::Shear,
                                    tensile ? tensile_stress : shear_stress});

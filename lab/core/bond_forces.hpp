@@ -26,6 +26,8 @@ struct BondPass {
   std::vector<double> stresses;
 
   bool lanes = true;  // 3D: four bonds per AVX register where the CPU has it (same bits)
+  // The kinds, indexed by BondStore::kind, for their friction angles (nullptr: none).
+  const std::vector<BondKind>* kinds = nullptr;
 };
 
 // Whether 3D bonds can run four per AVX register here (BondPass::lanes asks for it).
@@ -49,6 +51,7 @@ class BondForces {
   bool adjacency_valid_ = false;
   std::vector<std::vector<std::uint32_t>> block_broken_;
   std::vector<std::vector<std::pair<BondBreakMode, double>>> block_modes_;
+  std::vector<double> tan_friction_;  // per kind, this pass
 };
 
 }  // namespace rocklab

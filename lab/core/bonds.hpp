@@ -3,7 +3,9 @@
 // radius R = lambda min(r1, r2) between two particles, acting in parallel with their
 // contact law. The bond carries a normal force, a shear force, a bending moment and (3D) a
 // twisting moment, all updated incrementally from the relative motion; it breaks when the
-// largest tensile or shear stress at its periphery reaches its strength.
+// largest tensile or shear stress at its periphery reaches its strength. The shear strength
+// may grow with the compression the bond carries (a friction angle, as PFC 5's linear
+// parallel bond).
 
 #include <cstdint>
 #include <string>
@@ -36,6 +38,12 @@ struct BondKind {
   double tensile_std = 0.0;        // Pa
   double shear_mean = 0.0;         // Pa
   double shear_std = 0.0;          // Pa
+  // rad, phi: under a compressive normal stress sigma_n = Fn / A the shear strength is
+  // c + sigma_n tan(phi), c the drawn shear strength (Mohr-Coulomb; Potyondy 2015, the
+  // linear parallel bond's pb_fa). A tensile normal stress leaves it at c: tension is the
+  // tensile criterion's. 0: a shear strength independent of the load, as in PFC 3 (the
+  // paper's).
+  double friction_angle = 0.0;
   NegativeStrength negative = NegativeStrength::Skip;
 
   void validate() const;  // throws InvalidParameter
@@ -44,7 +52,8 @@ struct BondKind {
     ar("name", name), ar("intragranular", intragranular), ar("modulus", modulus);
     ar("stiffness_ratio", stiffness_ratio), ar("radius_multiplier", radius_multiplier);
     ar("tensile_mean", tensile_mean), ar("tensile_std", tensile_std);
-    ar("shear_mean", shear_mean), ar("shear_std", shear_std), ar("negative", negative);
+    ar("shear_mean", shear_mean), ar("shear_std", shear_std);
+    ar("friction_angle", friction_angle), ar("negative", negative);
   }
 };
 

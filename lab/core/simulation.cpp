@@ -334,7 +334,7 @@ void Simulation<D>::computeBondForces(double dt) {
   const auto t0 = std::chrono::steady_clock::now();
   auto& P = particles_;
   BondPass<D> pass{P,  bonds_, dt, threaded(),        config_.threads, config_.bond_breakage,
-                   {}, {},     {}, config_.bond_lanes};
+                   {}, {},     {}, config_.bond_lanes, &bond_kinds_};
   bond_forces_.compute(pass);
   if (!pass.broken.empty()) {
     // Second phase: log and remove the broken bonds in bond order.

@@ -251,8 +251,8 @@ class Simulation {
   // --- checkpoints ---
   void saveCheckpoint(const std::string& path) const;
   static Simulation loadCheckpoint(const std::string& path);
-  // Version 3 added config.bond_breakage.
-  static constexpr std::uint32_t kCheckpointVersion = 3;
+  // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle.
+  static constexpr std::uint32_t kCheckpointVersion = 4;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };

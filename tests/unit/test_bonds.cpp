@@ -188,6 +188,35 @@ TEST(BondBreaks, TwoDimensionalTension) {
       BondBreakMode::Tensile, strength, probe.kn() * v * kDt);
 }
 
+// A friction angle phi (PFC 5's pb_fa): sheared while it carries a compressive normal stress
+// sigma_n, a bond breaks at c + sigma_n tan(phi); while it carries tension, at c.
+TEST(BondBreaks, FrictionAngleRaisesTheShearStrengthUnderCompressionOnly) {
+  const double c = 2e6, phi = 40.0 * std::numbers::pi / 180.0, v = 0.01;
+  for (const double approach : {0.5e-6, -0.2e-6}) {  // m: compressed, then stretched
+    BondKind kind = cement(1e12, c);
+    kind.friction_angle = phi;
+    BondedPair<3> p(kind);
+    const int steps = 1000;  // the normal load, applied slowly (within the 2 um gap)
+    p.drive(V3::Zero(), -approach / (steps * kDt) * p.n, V3::Zero(), V3::Zero(), steps);
+    const double sigma_n = p.sim.bonds().load[0].fn / p.section().area;
+    EXPECT_NEAR(sigma_n, p.kn() * approach, 1e-6 * std::abs(p.kn() * approach));
+    const double strength = sigma_n > 0 ? c + sigma_n * std::tan(phi) : c;
+    std::vector<BondBreak<3>> breaks;
+    for (int s = 0; s < 100000 && breaks.empty(); ++s) {
+      p.drive(V3::Zero(), V3(0, v, 0), V3::Zero(), V3::Zero(), 1);
+      breaks = p.sim.takeBondBreaks();
+    }
+    ASSERT_EQ(breaks.size(), 1u) << "approach " << approach;
+    EXPECT_EQ(breaks[0].mode, BondBreakMode::Shear);
+    EXPECT_GE(breaks[0].stress, strength);
+    EXPECT_LT(breaks[0].stress, strength + 1.01 * p.ks() * v * kDt) << "approach " << approach;
+  }
+  BondKind k = cement(8e6, 8e6);
+  k.friction_angle = std::numbers::pi / 2;  // tan infinite
+  Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), SimulationConfig{});
+  EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
+}
+
 TEST(BondBreaks, CompressionDoesNotBreakAndTheContactRemains) {
   BondedPair<3> p(cement(1e3, 1e3));                               // weak
   p.drive(V3::Zero(), -0.01 * p.n, V3::Zero(), V3::Zero(), 3000);  // 1 um into contact
@@ -296,7 +325,8 @@ TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
 // jittered lattice of 7 x 5 x 4 spheres (bonds with gaps and overlaps, a count that leaves
 // a scalar tail after the groups of four), shaken with random velocities and spins so that
 // every mode loads and bonds break. Runs under the sanitizers too (the lanes read particles
-// with masked loads).
+// with masked loads). With a friction angle, the shear strengths come from the loads the
+// lanes stored.
 TEST(BondLanes, FourPerRegisterGiveTheScalarBits) {
   struct Outcome {
     std::vector<V3> pos, vel, spin;
@@ -320,7 +350,9 @@ TEST(BondLanes, FourPerRegisterGiveTheScalarBits) {
         }
       }
     }
-    const auto kind = sim.addBondKind(cement(2e6, 3e6));
+    BondKind cemented = cement(2e6, 3e6);
+    cemented.friction_angle = 0.5;  // rad: the shear strength read from the lanes' loads
+    const auto kind = sim.addBondKind(cemented);
     const std::size_t installed = sim.cement(kind, 0.1).installed;
     EXPECT_GT(installed, 300u);
     EXPECT_GT(installed % 4, 0u) << "no scalar tail after the groups of four: change the seed";
