@@ -328,6 +328,7 @@ BondOrientations bondOrientations(const Simulation<D>& sim, std::uint8_t kind, i
     const double c = std::abs(d[axis]) / d.norm();
     n.axial += c >= axial_cos ? 1 : 0;
     n.lateral += c <= lateral_cos ? 1 : 0;
+    n.inclined += c > lateral_cos && c < axial_cos ? 1 : 0;
   }
   return n;
 }
@@ -694,6 +695,9 @@ void recordState(Specimen<D>& sp, Recorder& rec, const std::string& prefix,
     };
     if (ref.axial > 0) put("broken_fraction_axial_bonds", broken(now.axial, ref.axial));
     if (ref.lateral > 0) put("broken_fraction_lateral_bonds", broken(now.lateral, ref.lateral));
+    if (ref.inclined > 0) {
+      put("broken_fraction_inclined_bonds", broken(now.inclined, ref.inclined));
+    }
   }
   if (sp.grain_kind) {
     put("broken_grain_bonds_tensile",

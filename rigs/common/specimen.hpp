@@ -39,9 +39,11 @@ void byDimension(const Settings& s, Body&& body) {
 // Intact bonds of one kind by their orientation to the sigma_1 axis: within 30 degrees of
 // it ("axial" bonds: their breaks open cracks across the axis) and within 30 degrees of the
 // plane normal to it ("lateral" bonds: cracks along the axis, which slow the waves that
-// cross it; Li & Holt section 4.2 explain Figure 18b's anisotropy by which of them fail).
+// cross it; Li & Holt section 4.2 explain Figure 18b's anisotropy by which of them fail),
+// and the rest, 30-60 degrees from the axis ("inclined": they carry most of the shear
+// stiffness in the planes through the axis, which the S wave along the axis, szx, sees).
 struct BondOrientations {
-  std::size_t axial = 0, lateral = 0;
+  std::size_t axial = 0, lateral = 0, inclined = 0;
 };
 template <int D>
 BondOrientations bondOrientations(const Simulation<D>& sim, std::uint8_t kind, int axis);
