@@ -18,6 +18,7 @@ void BondKind::validate() const {
   requireRange(where, "shear_std", shear_std, 0.0, false, INFINITY, true, "Pa");
   requireRange(where, "friction_angle", friction_angle, 0.0, false, std::numbers::pi / 2, true,
                "rad");
+  requireRange(where, "moment_factor", moment_factor, 0.0, false, 1.0, false, "-");
   // A mean at or below zero with Resample would loop for ever drawing a positive strength.
   const double lo = negative == NegativeStrength::Resample ? 0.0 : -INFINITY;
   requireRange(where, "tensile_mean", tensile_mean, lo, true, INFINITY, true, "Pa");
@@ -79,13 +80,30 @@ void BondForces<D>::compute(BondPass<D>& pass) {
   }
 
   tan_friction_.clear();
-  bool frictional = false;
+  moment_factor_.clear();
+  bool frictional = false, moments_scaled = false;
   if (pass.kinds) {
     for (const BondKind& k : *pass.kinds) {
       tan_friction_.push_back(std::tan(k.friction_angle));
+      moment_factor_.push_back(k.moment_factor);
       frictional = frictional || k.friction_angle > 0.0;
+      moments_scaled = moments_scaled || k.moment_factor != 1.0;
     }
   }
+  // The peak stresses with the moments' share scaled (BondKind::moment_factor), from the
+  // load either path stored, in bondForce's order; with every factor 1 those of the pass
+  // stand (the lanes' or bondForce's, the same bits).
+  auto scaledStresses = [&](std::size_t b, double& tensile, double& shear) {
+    const BondLoad<D>& l = B.load[b];
+    const auto s = BondSection<D>::of(B.radius[b], P.thickness);
+    const double beta = moment_factor_[B.kind[b]];
+    if constexpr (D == 3) {
+      shear = l.fs.norm() / s.area + beta * std::abs(l.mt) * s.radius / s.polar;
+    } else {
+      shear = l.fs.norm() / s.area;
+    }
+    tensile = -l.fn / s.area + beta * angNorm(l.mb) * s.radius / s.inertia;
+  };
   // The shear strength c + sigma_n tan(phi) under a compressive normal stress sigma_n
   // (BondKind::friction_angle); the bond's load is this step's, stored by either path.
   auto shearStrength = [&](std::size_t b) {
@@ -100,6 +118,7 @@ void BondForces<D>::compute(BondPass<D>& pass) {
   auto settle = [&](std::size_t blk, std::size_t b, const Vec<D>& force, const Ang<D>& ti,
                     const Ang<D>& tj, double tensile_stress, double shear_stress)
       __attribute__((always_inline)) {
+    if (moments_scaled) scaledStresses(b, tensile_stress, shear_stress);
     const double shear_strength = shearStrength(b);
     if (pass.breakable && (tensile_stress >= B.tensile[b] || shear_stress >= shear_strength)) {
       const double rt = tensile_stress / B.tensile[b], rs = shear_stress / shear_strength;

@@ -51,7 +51,7 @@ class BondForces {
   bool adjacency_valid_ = false;
   std::vector<std::vector<std::uint32_t>> block_broken_;
   std::vector<std::vector<std::pair<BondBreakMode, double>>> block_modes_;
-  std::vector<double> tan_friction_;  // per kind, this pass
+  std::vector<double> tan_friction_, moment_factor_;  // per kind, this pass
 };
 
 }  // namespace rocklab

@@ -44,6 +44,11 @@ struct BondKind {
   // tensile criterion's. 0: a shear strength independent of the load, as in PFC 3 (the
   // paper's).
   double friction_angle = 0.0;
+  // -, beta in [0, 1]: the share of the bending and twisting moments in the peak stresses,
+  // sigma = -Fn / A + beta |Mb| R / I and tau = |Fs| / A + beta |Mt| R / J (PFC 5's moment
+  // contribution factor, pb_mcf; Potyondy 2015). The moments still act on the particles.
+  // 1: the full beam stresses (Potyondy & Cundall 2004, the paper's).
+  double moment_factor = 1.0;
   NegativeStrength negative = NegativeStrength::Skip;
 
   void validate() const;  // throws InvalidParameter
@@ -53,7 +58,8 @@ struct BondKind {
     ar("stiffness_ratio", stiffness_ratio), ar("radius_multiplier", radius_multiplier);
     ar("tensile_mean", tensile_mean), ar("tensile_std", tensile_std);
     ar("shear_mean", shear_mean), ar("shear_std", shear_std);
-    ar("friction_angle", friction_angle), ar("negative", negative);
+    ar("friction_angle", friction_angle), ar("moment_factor", moment_factor);
+    ar("negative", negative);
   }
 };
 

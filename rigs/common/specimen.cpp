@@ -63,6 +63,9 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
   range(s.real("grain_bonds.friction_angle_deg", "deg", 1, 0.0,
                "intragranular bond friction angle (as bonds.friction_angle_deg)"),
         0, false, 85, false);
+  range(s.real("grain_bonds.moment_factor", "-", 1, 1.0,
+               "intragranular bond moment factor (as bonds.moment_factor)"),
+        0, false, 1, false);
   s.choice("sample.size_distribution", {"uniform", "normal", "phi"}, "phi",
            "diameters uniform in [d_min, d_max], normal(d_mean, d_std), or Gaussian in "
            "phi = -log2(d / 1 mm); normal and phi are truncated to [d_min, d_max]");
@@ -119,6 +122,10 @@ void declareCommon(protocol::Schema& s, const std::vector<std::string>& rig_name
                "bond friction angle: under a compressive normal stress sigma_n the shear strength "
                "is the drawn one plus sigma_n tan(angle) (PFC 5 pb_fa); 0: independent of load"),
         0, false, 85, false);
+  range(s.real("bonds.moment_factor", "-", 1, 1.0,
+               "share of the bending and twisting moments in the bond's peak stresses (PFC 5 "
+               "pb_mcf); 1: the full beam stresses"),
+        0, false, 1, false);
   s.choice("bonds.negative_strength", {"skip", "resample"}, "skip",
            "a strength drawn <= 0: skip (no bond: it would break unloaded) or resample");
   range(s.real("bonds.gap_ratio", "-", 1, 0.01,
@@ -463,6 +470,7 @@ Specimen<D> buildSpecimen(const Settings& s, RunControl& control) {
     k.shear_mean = s.si("grain_bonds.shear_strength_mean_MPa");
     k.shear_std = s.si("grain_bonds.shear_strength_std_MPa");
     k.friction_angle = s.real("grain_bonds.friction_angle_deg") * std::numbers::pi / 180.0;
+    k.moment_factor = s.real("grain_bonds.moment_factor");
     k.negative = NegativeStrength::Resample;  // a grain is never born cracked
     sp.grain_kind = sp.sim->addBondKind(k);
     sp.grain_bonds = sp.sim->cement(*sp.grain_kind, 1e-3);
@@ -509,6 +517,7 @@ void formAndCement(Specimen<D>& sp, const Settings& s, Recorder& rec, RunControl
     k.shear_mean = s.si("bonds.shear_strength_mean_MPa");
     k.shear_std = s.si("bonds.shear_strength_std_MPa");
     k.friction_angle = s.real("bonds.friction_angle_deg") * std::numbers::pi / 180.0;
+    k.moment_factor = s.real("bonds.moment_factor");
     k.negative = s.text("bonds.negative_strength") == "resample" ? NegativeStrength::Resample
                                                                  : NegativeStrength::Skip;
     sp.cement_kind = sim.addBondKind(k);

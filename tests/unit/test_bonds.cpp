@@ -180,6 +180,46 @@ TEST(BondBreaks, Bending) {
       BondBreakMode::Tensile, strength, increment);
 }
 
+// A moment factor beta (PFC 5's pb_mcf) scales the bending moment's share of the peak
+// tensile stress: bent at a steady rate, a bond with beta = 0.5 holds past the moment that
+// breaks a full beam and breaks at twice it; in 2D likewise.
+template <int D>
+void bendsToTwiceTheMoment() {
+  const double strength = 8e6, w = 10.0, beta = 0.5;
+  BondKind kind = cement(strength, 1e12);
+  kind.moment_factor = beta;
+  BondedPair<D> p(kind);
+  const auto s = p.section();
+  const double per_step = p.kn() * 2 * w * kDt * s.radius;  // |Mb| R / I per step, unscaled
+  const int full_beam = static_cast<int>(std::ceil(strength / per_step));
+  Ang<D> wa, wb;
+  if constexpr (D == 3) {
+    wa = V3(0, 0, -w), wb = V3(0, 0, w);
+  } else {
+    wa = -w, wb = w;
+  }
+  std::vector<BondBreak<D>> breaks;
+  int steps = 0;
+  for (; steps < 3 * full_beam && breaks.empty(); ++steps) {
+    p.drive(Vec<D>::Zero(), Vec<D>::Zero(), wa, wb, 1);
+    breaks = p.sim.takeBondBreaks();
+  }
+  ASSERT_EQ(breaks.size(), 1u);
+  EXPECT_EQ(breaks[0].mode, BondBreakMode::Tensile);
+  EXPECT_NEAR(steps, 2 * full_beam, 2) << "full beam: " << full_beam << " steps";
+  EXPECT_GE(breaks[0].stress, strength);
+  EXPECT_LT(breaks[0].stress, strength + 1.0001 * beta * per_step);
+}
+
+TEST(BondBreaks, MomentFactorScalesTheBendingStress) {
+  bendsToTwiceTheMoment<3>();
+  bendsToTwiceTheMoment<2>();
+  BondKind k = cement(8e6, 8e6);
+  k.moment_factor = 1.5;
+  Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), SimulationConfig{});
+  EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
+}
+
 TEST(BondBreaks, TwoDimensionalTension) {
   const double strength = 8e6, v = 0.01;
   BondedPair<2> probe(cement(strength, 1e12));
@@ -325,8 +365,8 @@ TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
 // jittered lattice of 7 x 5 x 4 spheres (bonds with gaps and overlaps, a count that leaves
 // a scalar tail after the groups of four), shaken with random velocities and spins so that
 // every mode loads and bonds break. Runs under the sanitizers too (the lanes read particles
-// with masked loads). With a friction angle, the shear strengths come from the loads the
-// lanes stored.
+// with masked loads). With a friction angle and a moment factor, the shear strengths and
+// the peak stresses come from the loads the lanes stored.
 TEST(BondLanes, FourPerRegisterGiveTheScalarBits) {
   struct Outcome {
     std::vector<V3> pos, vel, spin;
@@ -352,6 +392,7 @@ TEST(BondLanes, FourPerRegisterGiveTheScalarBits) {
     }
     BondKind cemented = cement(2e6, 3e6);
     cemented.friction_angle = 0.5;  // rad: the shear strength read from the lanes' loads
+    cemented.moment_factor = 0.7;   // the peak stresses recomputed from them
     const auto kind = sim.addBondKind(cemented);
     const std::size_t installed = sim.cement(kind, 0.1).installed;
     EXPECT_GT(installed, 300u);
