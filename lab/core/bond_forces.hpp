@@ -26,7 +26,8 @@ struct BondPass {
   std::vector<double> stresses;
 
   bool lanes = true;  // 3D: four bonds per AVX register where the CPU has it (same bits)
-  // The kinds, indexed by BondStore::kind, for their friction angles (nullptr: none).
+  // The kinds, indexed by BondStore::kind, for their friction angles and moment factors
+  // (nullptr: neither).
   const std::vector<BondKind>* kinds = nullptr;
 };
 

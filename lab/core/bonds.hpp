@@ -3,9 +3,9 @@
 // radius R = lambda min(r1, r2) between two particles, acting in parallel with their
 // contact law. The bond carries a normal force, a shear force, a bending moment and (3D) a
 // twisting moment, all updated incrementally from the relative motion; it breaks when the
-// largest tensile or shear stress at its periphery reaches its strength. The shear strength
-// may grow with the compression the bond carries (a friction angle, as PFC 5's linear
-// parallel bond).
+// largest tensile or shear stress at its periphery reaches its strength. As PFC 5's linear
+// parallel bond, the shear strength may grow with the compression the bond carries (a
+// friction angle) and the moments' share of those stresses may be scaled down.
 
 #include <cstdint>
 #include <string>

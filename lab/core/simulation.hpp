@@ -251,7 +251,7 @@ class Simulation {
   // --- checkpoints ---
   void saveCheckpoint(const std::string& path) const;
   static Simulation loadCheckpoint(const std::string& path);
-  // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle.
+  // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle and moment_factor.
   static constexpr std::uint32_t kCheckpointVersion = 4;
 
  private:
