@@ -93,9 +93,9 @@ void BondForces<D>::compute(BondPass<D>& pass) {
   // The peak stresses with the moments' share scaled (BondKind::moment_factor), from the
   // load either path stored, in bondForce's order; with every factor 1 those of the pass
   // stand (the lanes' or bondForce's, the same bits).
-  auto scaledStresses = [&](std::size_t b, double& tensile, double& shear) {
+  auto scaledStresses = [&](std::size_t b, const BondSection<D>& s, double& tensile,
+                            double& shear) {
     const BondLoad<D>& l = B.load[b];
-    const auto s = BondSection<D>::of(B.radius[b], P.thickness);
     const double beta = moment_factor_[B.kind[b]];
     if constexpr (D == 3) {
       shear = l.fs.norm() / s.area + beta * std::abs(l.mt) * s.radius / s.polar;
@@ -106,9 +106,8 @@ void BondForces<D>::compute(BondPass<D>& pass) {
   };
   // The shear strength c + sigma_n tan(phi) under a compressive normal stress sigma_n
   // (BondKind::friction_angle); the bond's load is this step's, stored by either path.
-  auto shearStrength = [&](std::size_t b) {
-    if (!frictional) return B.shear[b];
-    const double sigma_n = B.load[b].fn / BondSection<D>::of(B.radius[b], P.thickness).area;
+  auto frictionalStrength = [&](std::size_t b, const BondSection<D>& s) {
+    const double sigma_n = B.load[b].fn / s.area;
     return sigma_n > 0.0 ? B.shear[b] + sigma_n * tan_friction_[B.kind[b]] : B.shear[b];
   };
 
@@ -118,8 +117,12 @@ void BondForces<D>::compute(BondPass<D>& pass) {
   auto settle = [&](std::size_t blk, std::size_t b, const Vec<D>& force, const Ang<D>& ti,
                     const Ang<D>& tj, double tensile_stress, double shear_stress)
       __attribute__((always_inline)) {
-    if (moments_scaled) scaledStresses(b, tensile_stress, shear_stress);
-    const double shear_strength = shearStrength(b);
+    double shear_strength = B.shear[b];
+    if (pass.breakable && (moments_scaled || frictional)) {  // only breaks need them
+      const auto section = BondSection<D>::of(B.radius[b], P.thickness);
+      if (moments_scaled) scaledStresses(b, section, tensile_stress, shear_stress);
+      if (frictional) shear_strength = frictionalStrength(b, section);
+    }
     if (pass.breakable && (tensile_stress >= B.tensile[b] || shear_stress >= shear_strength)) {
       const double rt = tensile_stress / B.tensile[b], rs = shear_stress / shear_strength;
       const bool tensile =
