@@ -291,6 +291,7 @@ Specimen<D> Specimen<D>::branch() const {
   b.density = density;
   b.cement_kind = cement_kind;
   b.cement = cement;
+  b.cement_classes = cement_classes;
   b.cement_reference = cement_reference;
   b.grain_kind = grain_kind;
   b.grain_bonds = grain_bonds;
@@ -324,18 +325,50 @@ std::size_t Specimen<D>::crushedGrains() const {
 
 template <int D>
 BondOrientations bondOrientations(const Simulation<D>& sim, std::uint8_t kind, int axis) {
+  return intactByClass(sim, kind, bondClasses(sim, kind, axis));
+}
+
+namespace {
+
+// A bond's key: its particles' slots, the lower first.
+template <int D>
+std::uint64_t bondKey(const ParticleStore<D>& P, std::uint32_t i, std::uint32_t j) {
+  const std::uint64_t a = P.slot_of[i], b = P.slot_of[j];
+  return std::min(a, b) << 32 | std::max(a, b);
+}
+
+}  // namespace
+
+template <int D>
+BondClasses bondClasses(const Simulation<D>& sim, std::uint8_t kind, int axis) {
   // |cos| of the angle to the axis: above cos 30 deg axial, below cos 60 deg lateral.
   const double axial_cos = std::cos(std::numbers::pi / 6), lateral_cos = 0.5;
+  const auto& P = sim.particles();
+  const auto& B = sim.bonds();
+  BondClasses classes;
+  for (std::size_t b = 0; b < B.size(); ++b) {
+    if (B.kind[b] != kind) continue;
+    const Vec<D> d = P.pos[B.j[b]] - P.pos[B.i[b]];
+    const double c = std::abs(d[axis]) / d.norm();
+    const std::uint8_t k = c >= axial_cos ? 0 : c <= lateral_cos ? 2 : 1;
+    classes.emplace(bondKey(P, B.i[b], B.j[b]), k);
+  }
+  return classes;
+}
+
+template <int D>
+BondOrientations intactByClass(const Simulation<D>& sim, std::uint8_t kind,
+                               const BondClasses& reference) {
   const auto& P = sim.particles();
   const auto& B = sim.bonds();
   BondOrientations n;
   for (std::size_t b = 0; b < B.size(); ++b) {
     if (B.kind[b] != kind) continue;
-    const Vec<D> d = P.pos[B.j[b]] - P.pos[B.i[b]];
-    const double c = std::abs(d[axis]) / d.norm();
-    n.axial += c >= axial_cos ? 1 : 0;
-    n.lateral += c <= lateral_cos ? 1 : 0;
-    n.inclined += c > lateral_cos && c < axial_cos ? 1 : 0;
+    const auto it = reference.find(bondKey(P, B.i[b], B.j[b]));
+    if (it == reference.end()) continue;  // installed since (none are, in the rigs)
+    n.axial += it->second == 0 ? 1 : 0;
+    n.inclined += it->second == 1 ? 1 : 0;
+    n.lateral += it->second == 2 ? 1 : 0;
   }
   return n;
 }
@@ -347,7 +380,10 @@ void Specimen<D>::resetBrokenCount() {
     if (cement_kind) broken_offset[m] = sim->brokenBonds(*cement_kind, mode);
     if (grain_kind) broken_offset[2 + m] = sim->brokenBonds(*grain_kind, mode);
   }
-  if (cement_kind) cement_reference = bondOrientations(*sim, *cement_kind, kAxial);
+  if (cement_kind) {
+    cement_classes = bondClasses(*sim, *cement_kind, kAxial);
+    cement_reference = intactByClass(*sim, *cement_kind, cement_classes);
+  }
   if (grain_kind) {
     fragments_reference = grainFragments<D>(sim->particles(), sim->bonds(), sim->bondKinds());
   }
@@ -697,7 +733,7 @@ void recordState(Specimen<D>& sp, Recorder& rec, const std::string& prefix,
   if (sp.cement_kind) {
     // Which cement broke, by orientation (BondOrientations): the fraction of each class
     // intact at the stage's start that has broken since.
-    const BondOrientations now = bondOrientations(sim, *sp.cement_kind, ax);
+    const BondOrientations now = intactByClass(sim, *sp.cement_kind, sp.cement_classes);
     const BondOrientations& ref = sp.cement_reference;
     auto broken = [](std::size_t intact, std::size_t reference) {
       return 1.0 - static_cast<double>(intact) / static_cast<double>(reference);
@@ -740,6 +776,10 @@ template void recordState<3>(Specimen<3>&, Recorder&, const std::string&, const 
 template void recordBreaks<2>(Specimen<2>&, Recorder&, const std::string&);
 template BondOrientations bondOrientations<2>(const Simulation<2>&, std::uint8_t, int);
 template BondOrientations bondOrientations<3>(const Simulation<3>&, std::uint8_t, int);
+template BondClasses bondClasses<2>(const Simulation<2>&, std::uint8_t, int);
+template BondClasses bondClasses<3>(const Simulation<3>&, std::uint8_t, int);
+template BondOrientations intactByClass<2>(const Simulation<2>&, std::uint8_t, const BondClasses&);
+template BondOrientations intactByClass<3>(const Simulation<3>&, std::uint8_t, const BondClasses&);
 template void snapshot<2>(Specimen<2>&, const Settings&, Recorder&, const std::string&,
                           const std::string&);
 template void snapshot<3>(Specimen<3>&, const Settings&, Recorder&, const std::string&,

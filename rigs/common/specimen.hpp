@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <type_traits>
+#include <unordered_map>
 
 #include "lab/protocol/params.hpp"
 #include "rigs/common/experiment.hpp"
@@ -48,6 +49,19 @@ struct BondOrientations {
 template <int D>
 BondOrientations bondOrientations(const Simulation<D>& sim, std::uint8_t kind, int axis);
 
+// Each bond of one kind, keyed by its two particles' slots (which outlive the particles'
+// sorting and the removal of broken bonds), with its orientation class at this instant:
+// 0 axial, 1 inclined, 2 lateral.
+using BondClasses = std::unordered_map<std::uint64_t, std::uint8_t>;
+template <int D>
+BondClasses bondClasses(const Simulation<D>& sim, std::uint8_t kind, int axis);
+// The bonds of `kind` intact now, each counted in the class it had in `reference`: a bond
+// that turns across a class boundary under load stays in its class, so a class's broken
+// fraction cannot fall below zero (counted by the present orientation, it did, by 0.001).
+template <int D>
+BondOrientations intactByClass(const Simulation<D>& sim, std::uint8_t kind,
+                               const BondClasses& reference);
+
 template <int D>
 struct Specimen {
   std::unique_ptr<Simulation<D>> sim;
@@ -69,7 +83,9 @@ struct Specimen {
   // cement tensile, shear, then grain tensile, shear; likewise the grains' fragments.
   std::uint64_t broken_offset[4] = {0, 0, 0, 0};
   std::vector<std::uint32_t> fragments_reference;
-  BondOrientations cement_reference;  // intact cement at the measured stage's start
+  // Intact cement at the measured stage's start: each bond's class, and their counts.
+  BondClasses cement_classes;
+  BondOrientations cement_reference;
   // Positions of the breaks handed to the notebook while this is on (localisation).
   bool keep_break_positions = false;
   std::vector<std::array<double, 3>> break_positions;
