@@ -165,8 +165,14 @@ TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
   LoadingCurve curve;
   std::vector<std::size_t> breaks_at;  // break positions kept by each record
   // States at every twentieth of the strain range, the start of the incremental strain field.
-  std::vector<std::pair<double, std::vector<std::array<double, 3>>>> states;
-  states.emplace_back(0.0, slotPositions(sim));
+  struct State {
+    double strain = 0.0;
+    std::uint64_t step = 0;
+    double time = 0.0;
+    std::vector<std::array<double, 3>> positions;
+  };
+  std::vector<State> states;
+  states.push_back({0.0, sim.steps(), sim.time(), slotPositions(sim)});
   // A confinement below 1 MPa is judged against 1 MPa: at zero the walls just keep clear.
   const double error_scale = std::max(sigma3, 1e6);
   bool done = false;
@@ -189,8 +195,8 @@ TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
       curve.q.push_back(q);
       curve.volumetric_strain.push_back(frame.volumetricStrain());
       breaks_at.push_back(sp.break_positions.size());
-      if (strain >= states.back().first + strain_max / 20.0) {
-        states.emplace_back(strain, slotPositions(sim));
+      if (strain >= states.back().strain + strain_max / 20.0) {
+        states.push_back({strain, sim.steps(), sim.time(), slotPositions(sim)});
       }
       for (int a = 0; a < D - 1; ++a) {
         confining_error =
@@ -277,26 +283,37 @@ TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
   const StrainPart part = compactive ? StrainPart::Compaction : StrainPart::Shear;
   const double width = s.real("analysis.band_width_radii") * sp.mean_radius;
   std::size_t from = 0;
-  while (from + 1 < states.size() && states[from + 1].first <= field_from) ++from;
-  states.emplace_back(frame.strain(ax), slotPositions(sim));
+  while (from + 1 < states.size() && states[from + 1].strain <= field_from) ++from;
+  states.push_back({frame.strain(ax), sim.steps(), sim.time(), slotPositions(sim)});
   struct Window {
     double from = 0.0, to = 0.0;
     Band band;
   };
   std::optional<Window> best;
-  auto consider = [&](std::size_t a, std::size_t b) {
-    const auto pts = strainedParticles(states[a].second, states[b].second, D, 4.0 * sp.mean_radius,
-                                       s.real("analysis.strained_fraction"), part);
-    if (pts.size() < 10) return;
+  auto consider = [&](std::size_t a, std::size_t b) -> std::optional<Band> {
+    const auto pts =
+        strainedParticles(states[a].positions, states[b].positions, D, 4.0 * sp.mean_radius,
+                          s.real("analysis.strained_fraction"), part);
+    if (pts.size() < 10) return std::nullopt;
     const Band band = findBand(pts, D, ax, width);
     if (!best || band.contrast > best->band.contrast) {
-      best = Window{states[a].first, states[b].first, band};
+      best = Window{states[a].strain, states[b].strain, band};
     }
+    return band;
   };
   const std::size_t last = states.size() - 1;
   consider(from, last);
   if (compactive) {
-    for (std::size_t k = from; k + 1 < last; ++k) consider(k, k + 1);
+    // Each window's band, at the window's end: how the band moves and turns as the
+    // compaction proceeds.
+    for (std::size_t k = from; k + 1 < last; ++k) {
+      if (const auto band = consider(k, k + 1)) {
+        rec.series(prefix + "band_window_angle_deg", states[k + 1].step, states[k + 1].time,
+                   band->angle_to_axial_deg);
+        rec.series(prefix + "band_window_contrast", states[k + 1].step, states[k + 1].time,
+                   band->contrast);
+      }
+    }
   }
   put("band_in_compaction_field", compactive ? 1.0 : 0.0, "");
   const std::string field = compactive ? "most compacted particles" : "most sheared particles";
