@@ -22,9 +22,9 @@ struct Trial {
 // lengths `a` (|n_d| times the side, d < dims) below `t`, measured from the projection's
 // low end: the distribution of a sum of independent uniform variables on [0, a_d],
 // F(t) = sum over subsets S of (-1)^|S| (t - sum_S a_d)_+^k / (k! prod a_d) with k the
-// non-zero lengths (Feller, An Introduction to Probability Theory II, section I.9). A
-// length below 1e-3 of the longest counts as zero: the formula cancels badly there, and
-// such a side moves the window's share by less than 1e-3 of its width.
+// non-zero lengths (the Irwin-Hall formula, extended to unequal widths). A length below
+// 1e-3 of the longest counts as zero: the formula cancels badly there, and such a side
+// moves the window's share by less than 1e-3 of its width.
 double uniformShareBelow(const std::array<double, 3>& a, int dims, double t) {
   std::array<double, 3> len{};
   int k = 0;
@@ -52,9 +52,9 @@ double uniformShareBelow(const std::array<double, 3>& a, int dims, double t) {
 // from a uniform cloud in the box from `lo` to `hi`, along the direction `n`: the largest
 // excess over the uniform count in Poisson standard deviations (a scan statistic). The
 // ratio alone favours short windows, whose counts scatter more: on the quick shear-band
-// sample a noisy window across the axis beat the inclined band. Windows
-// whose section through the box is smaller than the box's smallest cross-section (they
-// clip a corner or leave the box) are not considered: a band crosses the sample.
+// sample a noisy window across the axis beat the inclined band. Windows whose section
+// through the box is smaller than the box's smallest cross-section (they clip a corner or
+// leave the box) are not considered: a band crosses the sample.
 Trial mostSignificantWindow(std::vector<double>& rho, double width, const std::array<double, 3>& n,
                             const std::array<double, 3>& lo, const std::array<double, 3>& hi,
                             int dims) {
