@@ -292,7 +292,6 @@ Specimen<D> Specimen<D>::branch() const {
   b.cement_kind = cement_kind;
   b.cement = cement;
   b.cement_classes = cement_classes;
-  b.cement_reference = cement_reference;
   b.grain_kind = grain_kind;
   b.grain_bonds = grain_bonds;
   b.grain_aspect_ratios = grain_aspect_ratios;
@@ -325,7 +324,17 @@ std::size_t Specimen<D>::crushedGrains() const {
 
 template <int D>
 BondOrientations bondOrientations(const Simulation<D>& sim, std::uint8_t kind, int axis) {
-  return intactByClass(sim, kind, bondClasses(sim, kind, axis));
+  return countClasses(bondClasses(sim, kind, axis));
+}
+
+BondOrientations countClasses(const BondClasses& classes) {
+  BondOrientations n;
+  for (const auto& [key, k] : classes) {
+    n.axial += k == 0 ? 1 : 0;
+    n.inclined += k == 1 ? 1 : 0;
+    n.lateral += k == 2 ? 1 : 0;
+  }
+  return n;
 }
 
 namespace {
@@ -380,10 +389,7 @@ void Specimen<D>::resetBrokenCount() {
     if (cement_kind) broken_offset[m] = sim->brokenBonds(*cement_kind, mode);
     if (grain_kind) broken_offset[2 + m] = sim->brokenBonds(*grain_kind, mode);
   }
-  if (cement_kind) {
-    cement_classes = bondClasses(*sim, *cement_kind, kAxial);
-    cement_reference = intactByClass(*sim, *cement_kind, cement_classes);
-  }
+  if (cement_kind) cement_classes = bondClasses(*sim, *cement_kind, kAxial);
   if (grain_kind) {
     fragments_reference = grainFragments<D>(sim->particles(), sim->bonds(), sim->bondKinds());
   }
@@ -734,7 +740,7 @@ void recordState(Specimen<D>& sp, Recorder& rec, const std::string& prefix,
     // Which cement broke, by orientation (BondOrientations): the fraction of each class
     // intact at the stage's start that has broken since.
     const BondOrientations now = intactByClass(sim, *sp.cement_kind, sp.cement_classes);
-    const BondOrientations& ref = sp.cement_reference;
+    const BondOrientations ref = countClasses(sp.cement_classes);
     auto broken = [](std::size_t intact, std::size_t reference) {
       return 1.0 - static_cast<double>(intact) / static_cast<double>(reference);
     };

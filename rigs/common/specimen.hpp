@@ -61,6 +61,8 @@ BondClasses bondClasses(const Simulation<D>& sim, std::uint8_t kind, int axis);
 template <int D>
 BondOrientations intactByClass(const Simulation<D>& sim, std::uint8_t kind,
                                const BondClasses& reference);
+// The bonds of each class in `classes`.
+BondOrientations countClasses(const BondClasses& classes);
 
 template <int D>
 struct Specimen {
@@ -83,9 +85,7 @@ struct Specimen {
   // cement tensile, shear, then grain tensile, shear; likewise the grains' fragments.
   std::uint64_t broken_offset[4] = {0, 0, 0, 0};
   std::vector<std::uint32_t> fragments_reference;
-  // Intact cement at the measured stage's start: each bond's class, and their counts.
-  BondClasses cement_classes;
-  BondOrientations cement_reference;
+  BondClasses cement_classes;  // intact cement at the measured stage's start
   // Positions of the breaks handed to the notebook while this is on (localisation).
   bool keep_break_positions = false;
   std::vector<std::array<double, 3>> break_positions;
