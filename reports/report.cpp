@@ -72,10 +72,10 @@ FieldValues field(const std::string& which, const Frame& f, const Frame& first, 
   } else if (which == "broken_bonds") {
     v.label = "broken bonds per particle";
     std::unordered_map<std::int64_t, double> count;
-    for (const EventRow& e : r.breaks) {
+    for (const notebook::EventRecord& e : r.breaks) {
       if (e.stage != snap.stage || e.step > snap.step) continue;
-      count[e.a] += 1.0;
-      count[e.b] += 1.0;
+      count[e.particle_a] += 1.0;
+      count[e.particle_b] += 1.0;
     }
     for (std::size_t i = 0; i < f.size(); ++i) {
       auto it = count.find(f.slot[i]);
@@ -107,9 +107,9 @@ FieldValues field(const std::string& which, const Frame& f, const Frame& first, 
 
 std::vector<BreakMark> breaksUpTo(const RunData& r, const SnapshotRow& snap) {
   std::vector<BreakMark> out;
-  for (const EventRow& e : r.breaks) {
+  for (const notebook::EventRecord& e : r.breaks) {
     if (e.stage != snap.stage || e.step > snap.step) continue;
-    out.push_back({{e.x, e.y, e.z}, e.mode == "tensile", e.intragranular});
+    out.push_back({{e.x, e.y, e.z}, e.mode == "tensile", e.granular == "intra"});
   }
   return out;
 }

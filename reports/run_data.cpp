@@ -69,24 +69,8 @@ RunData loadRun(notebook::Notebook& nb, std::int64_t run) {
                              s.text(3), nb.resolve(s.text(4))});
     }
   }
-  {
-    auto s = db.prepare(
-        "SELECT step, coalesce(stage, ''), mode, x, y, z, particle_a, particle_b, "
-        "coalesce(granular, '') = 'intra' FROM events "
-        "WHERE run_id = ? AND kind = 'bond_break' ORDER BY step");
-    s.bind(1, run);
-    while (s.step()) {
-      r.breaks.push_back({static_cast<std::uint64_t>(s.integer(0)), s.text(1), s.text(2), s.real(3),
-                          s.real(4), s.real(5), s.integer(6), s.integer(7), s.integer(8) != 0});
-    }
-  }
-  {
-    auto s = db.prepare(
-        "SELECT coalesce(stage, ''), x, y, z, value FROM events "
-        "WHERE run_id = ? AND kind = 'pore_pressure' ORDER BY rowid");
-    s.bind(1, run);
-    while (s.step()) r.pores.push_back({s.text(0), s.real(1), s.real(2), s.real(3), s.real(4)});
-  }
+  r.breaks = notebook::eventRecords(nb, run, "bond_break");
+  r.pores = notebook::eventRecords(nb, run, "pore_pressure");
   r.waves = notebook::wavesOf(nb, run);
   return r;
 }

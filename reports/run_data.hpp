@@ -26,20 +26,6 @@ struct SnapshotRow {
   std::string stage, label, path;  // path resolved against the notebook
 };
 
-struct EventRow {
-  std::uint64_t step;
-  std::string stage, mode;
-  double x, y, z;
-  std::int64_t a, b;
-  bool intragranular;  // inside a grain (crushing) rather than between grains
-};
-
-// The steady pressure of one pore of a flow network (permeameter), at its centroid.
-struct PoreRow {
-  std::string stage;  // "initial" or "final"
-  double x, y, z, pressure;
-};
-
 struct RunData {
   std::int64_t id = 0;
   std::string protocol, rig, status, reason, started, code_version, build_type, protocol_file;
@@ -50,9 +36,9 @@ struct RunData {
   std::vector<std::pair<std::string, std::string>> messages;           // level, text
   std::map<std::string, SeriesData> series;
   std::vector<SnapshotRow> snapshots;
-  std::vector<EventRow> breaks;          // bond breaks
-  std::vector<PoreRow> pores;            // pore pressures
-  std::vector<notebook::WaveRow> waves;  // ultrasonic measurements with traces and picks
+  std::vector<notebook::EventRecord> breaks;  // bond breaks
+  std::vector<notebook::EventRecord> pores;   // steady pore pressures (value), by stage
+  std::vector<notebook::WaveRecord> waves;    // ultrasonic measurements with traces and picks
 
   std::string label() const { return "run " + std::to_string(id) + " " + protocol; }
   const SeriesData* find(const std::string& name) const {

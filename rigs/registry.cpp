@@ -2,7 +2,6 @@
 
 #include "rigs/biaxial/biaxial.hpp"
 #include "rigs/biaxial/envelope.hpp"
-#include "rigs/common/specimen.hpp"
 #include "rigs/hydrostatic/hydrostatic.hpp"
 #include "rigs/oedometer/oedometer.hpp"
 #include "rigs/permeameter/permeameter.hpp"
@@ -12,28 +11,30 @@ namespace rocklab::rigs {
 
 const std::vector<RigEntry>& rigTable() {
   static const std::vector<RigEntry> table = {
-      {"oedometer",
-       "uniaxial strain: lateral walls fixed, axial strain rate or stress ramp, cycles, coring",
-       oedometer::declare, oedometer::validate, oedometer::run},
-      {"biaxial",
-       "biaxial frame (2D) / triaxial cell (3D): confinement held by servo walls, axial strain "
-       "rate through the peak; zero confinement is the UCS test",
-       biaxial::declare, biaxial::validate, biaxial::run},
-      {"envelope",
-       "failure envelope: one formed sample, a biaxial / triaxial test at each confinement of a "
-       "sweep; critical points, Mohr-Coulomb line and end cap",
-       envelope::declare, envelope::validate, envelope::run},
-      {"hydrostatic", "all walls servo-controlled to one stress, ramped up and optionally down",
-       hydrostatic::declare, hydrostatic::validate, hydrostatic::run},
-      {"permeameter",
-       "permeameter: pore fluid driven through the sample between fixed end pressures, steady "
-       "flow every n steps, Darcy permeability under hydrostatic or biaxial / triaxial loading",
-       permeameter::declare, permeameter::validate, permeameter::run},
-      {"ultrasonic",
-       "ultrasonic bench: P and S waves (pz, px, szx, sxy) through copies of a sample at stages "
-       "of hydrostatic, uniaxial-strain or triaxial loading; FFT-picked velocities, dynamic "
-       "and static moduli",
-       ultrasonic::declare, ultrasonic::validate, ultrasonic::run},
+      rigEntry<oedometer::Settings, oedometer::run>(
+          "oedometer",
+          "uniaxial strain: lateral walls fixed, axial strain rate or stress ramp, cycles, "
+          "coring"),
+      rigEntry<biaxial::Settings, biaxial::run>(
+          "biaxial",
+          "biaxial frame (2D) / triaxial cell (3D): confinement held by servo walls, axial "
+          "strain rate through the peak; zero confinement is the UCS test"),
+      rigEntry<envelope::Settings, envelope::run>(
+          "envelope",
+          "failure envelope: one formed sample, a biaxial / triaxial test at each confinement "
+          "of a sweep; critical points, Mohr-Coulomb line and end cap"),
+      rigEntry<hydrostatic::Settings, hydrostatic::run>(
+          "hydrostatic", "all walls servo-controlled to one stress, ramped up and optionally down"),
+      rigEntry<permeameter::Settings, permeameter::run>(
+          "permeameter",
+          "permeameter: pore fluid driven through the sample between fixed end pressures, "
+          "steady flow every n steps, Darcy permeability under hydrostatic or biaxial / "
+          "triaxial loading"),
+      rigEntry<ultrasonic::Settings, ultrasonic::run>(
+          "ultrasonic",
+          "ultrasonic bench: P and S waves (pz, px, szx, sxy) through copies of a sample at "
+          "stages of hydrostatic, uniaxial-strain or triaxial loading; FFT-picked velocities, "
+          "dynamic and static moduli"),
   };
   return table;
 }
@@ -52,8 +53,8 @@ protocol::Schema schemaOf(const RigEntry& rig) {
   std::vector<std::string> names;
   for (const RigEntry& r : rigTable()) names.emplace_back(r.name);
   protocol::Schema s;
-  declareCommon(s, names);
   rig.declare(s);
+  s.setChoices("protocol.rig", names);
   s.setRig(std::string(rig.name));
   for (const RigEntry& other : rigTable()) {
     if (other.name == rig.name) continue;
@@ -66,6 +67,27 @@ protocol::Schema schemaOf(const RigEntry& rig) {
   return s;
 }
 
+namespace {
+
+// Every name in protocol.key_results must be one of the rig's key results.
+void checkKeyResults(const RigEntry& rig, const protocol::Settings& s) {
+  const std::string key = "protocol.key_results";
+  std::vector<std::string> problems;
+  for (const std::string& name : s.texts(key)) {
+    if (rig.outputs().keyResult(name)) continue;
+    std::string known;
+    for (const OutputDecl& d : rig.outputs().keyResults()) {
+      known += (known.empty() ? "" : ", ") + std::string(d.name);
+    }
+    problems.push_back(s.where(key) + ": " + key + ": '" + name + "' is not a key result of the " +
+                       std::string(rig.name) + " rig: one of " + known + " (`rocklab keys " +
+                       std::string(rig.name) + "` says what each is)");
+  }
+  if (!problems.empty()) throw protocol::ProtocolError(problems);
+}
+
+}  // namespace
+
 CheckedProtocol checkProtocol(const std::string& path) {
   const std::string text = protocol::readFile(path);
   const RigEntry& rig = findRig(protocol::rigOf(path, text), path);
@@ -75,8 +97,8 @@ CheckedProtocol checkProtocol(const std::string& path) {
 }
 
 void validateProtocol(const RigEntry& rig, const protocol::Settings& s) {
-  validateCommon(s);
-  rig.validate(s);
+  rig.check(s);
+  checkKeyResults(rig, s);
 }
 
 }  // namespace rocklab::rigs

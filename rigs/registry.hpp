@@ -1,13 +1,16 @@
 #pragma once
-// The rigs a protocol can name: one table row per rig. A row declares the rig's own
-// protocol keys, checks them across keys, and runs the protocol.
+// The rigs a protocol can name: one table row per rig. A rig is a settings struct (its
+// protocol keys, declared once: lab/core/fields.hpp), a run function taking it, and its
+// outputs (rigs/common/outputs.hpp); the row makes the schema, the checks and the run of its
+// protocols from them.
 
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "lab/protocol/params.hpp"
+#include "lab/protocol/declare.hpp"
 #include "rigs/common/experiment.hpp"
+#include "rigs/common/outputs.hpp"
 
 namespace rocklab::rigs {
 
@@ -15,16 +18,30 @@ struct RigEntry {
   std::string_view name;
   std::string_view doc;
   void (*declare)(protocol::Schema&);
-  void (*validate)(const protocol::Settings&);
+  // Reads the settings into the rig's struct, which checks its rules across keys (throws
+  // protocol::ProtocolError).
+  void (*check)(const protocol::Settings&);
   void (*run)(const protocol::Settings&, Recorder&, RunControl&);
+  const Outputs& outputs() const { return *rigOutputs(name); }
 };
+
+// A row for a rig whose settings are `S` and whose run is `Run`.
+template <class S, void (*Run)(const S&, Recorder&, RunControl&)>
+RigEntry rigEntry(std::string_view name, std::string_view doc) {
+  return {name, doc, [](protocol::Schema& s) { protocol::declare<S>(s); },
+          [](const protocol::Settings& s) { (void)protocol::read<S>(s); },
+          [](const protocol::Settings& s, Recorder& rec, RunControl& control) {
+            Run(protocol::read<S>(s), rec, control);
+          }};
+}
 
 const std::vector<RigEntry>& rigTable();
 // Throws protocol::ProtocolError listing the rigs when `name` is none of them.
 const RigEntry& findRig(std::string_view name, const std::string& file);
 // The whole schema of a rig's protocols: the shared sections and the rig's own.
 protocol::Schema schemaOf(const RigEntry& rig);
-// Reads and checks a protocol file completely (keys, types, ranges, cross-key rules).
+// Reads and checks a protocol file completely (keys, types, ranges, rules across keys, the
+// key results it names).
 struct CheckedProtocol {
   const RigEntry* rig;
   protocol::Settings settings;

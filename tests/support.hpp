@@ -13,6 +13,7 @@ inline Material linearMaterial(double kn, double ks, double friction, double dam
   m.name = "linear";
   m.kn = kn;
   m.ks = ks;
+  m.modulus = 0.0;  // the particle springs alone
   m.friction = friction;
   m.damping_ratio = damping_ratio;
   m.density = density;
@@ -29,6 +30,14 @@ inline Material hertzMaterial(double young, double poisson, double friction,
   m.damping_ratio = damping_ratio;
   m.density = density;
   return m;
+}
+
+// Without local damping: tests of dynamics (collisions, waves, energy) need the motion
+// undamped; the core's default (PFC's 0.7) is for quasi-static loading.
+inline SimulationConfig undamped() {
+  SimulationConfig c;
+  c.local_damping = 0.0;
+  return c;
 }
 
 inline MaterialTable table(const Material& m) {

@@ -31,7 +31,7 @@ constexpr double kStrainRate = 1.0;   // 1/s, each wall moves in at edot * L / 2
 // The bonded variant: PFC-like cement stiff enough to matter (E 10 GPa, lambda 1) and too
 // strong to break in the timed phase, so it measures the bonds' force pass alone.
 constexpr double kBondModulus = 10e9;   // Pa
-constexpr double kBondStrength = 1e12;  // Pa
+constexpr double kBondStrength = 1e11;  // Pa
 
 // The damping ratio that gives restitution e for a linear dashpot; with Tsuji's Hertz
 // dashpot the peers use the same beta (LIGGGHTS and Yade).
@@ -109,6 +109,7 @@ Packing<3> benchPacking(std::size_t n, std::uint64_t seed, int threads) {
   // Servo all six walls to 1 MPa with friction 0.1 (the peers' preparation).
   SimulationConfig cfg;
   cfg.contact_law = "hertz";
+  cfg.skin_ratio = 0.1;
   cfg.local_damping = 0.4;
   cfg.threads = threads;
   cfg.track_energy = false;
@@ -197,6 +198,7 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
   SimulationConfig cfg;
   cfg.contact_law = "hertz";
   cfg.skin = options.skin;
+  cfg.local_damping = 0.0;  // the peers' scene: contact dashpots only
   cfg.timestep.automatic = false;
   cfg.timestep.fixed_dt = kTimeStep;
   cfg.threads = threads;
@@ -213,7 +215,9 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
     sim.prepare();
     BondKind cement;
     cement.modulus = kBondModulus;
+    cement.stiffness_ratio = 1.0;
     cement.tensile_mean = cement.shear_mean = kBondStrength;
+    cement.tensile_std = cement.shear_std = 0.0;
     r.bonds = sim.cement(sim.addBondKind(cement), 0.0).installed;
     r.bond_lanes = cfg.bond_lanes && bondLanesAvailable();
   }
@@ -249,7 +253,9 @@ FlowBenchResult runFlowBench(const Packing<3>& packing) {
   cfg.contact_law = "hertz";
   cfg.track_energy = false;
   const Simulation<3> sim = makeScene(packing, kFriction, cfg);
-  flow::FlowCoupling<3> coupling{flow::FlowSettings{}};
+  flow::FlowSettings settings;
+  settings.merge.small_pore_ratio = 0.0;  // as Yade's FlowEngine: every cell a pore
+  flow::FlowCoupling<3> coupling{settings};
   const flow::FlowReading first = coupling.measure(sim);
   const flow::FlowReading repeat = coupling.measure(sim);
   FlowBenchResult r;

@@ -12,6 +12,7 @@
 #include "lab/notebook/queries.hpp"
 #include "reports/key_results.hpp"
 #include "reports/run_data.hpp"
+#include "rigs/common/checked_recorder.hpp"
 #include "rigs/registry.hpp"
 
 namespace rocklab::cli {
@@ -44,13 +45,7 @@ class NotebookRecorder : public rigs::Recorder {
   void series(std::string_view name, std::uint64_t step, double time, double value) override {
     w_.series(name, step, time, value);
   }
-  void event(const rigs::EventRecord& e) override {
-    notebook::EventRow r;
-    r.step = e.step, r.time = e.time, r.stage = e.stage, r.kind = e.kind, r.mode = e.mode;
-    r.x = e.x, r.y = e.y, r.z = e.z, r.particle_a = e.particle_a, r.particle_b = e.particle_b;
-    r.granular = e.granular, r.value = e.value;
-    w_.event(r);
-  }
+  void event(const rigs::EventRecord& e) override { w_.event(e); }
   void result(std::string_view name, double value, std::string_view unit) override {
     w_.result(name, value, unit);
   }
@@ -65,30 +60,7 @@ class NotebookRecorder : public rigs::Recorder {
   void snapshot(std::string_view stage, std::string_view label, const Frame& frame) override {
     w_.snapshot("frame", stage, label, frame.step, frame.time, encodeFrame(frame), "rkf");
   }
-  void wave(const rigs::WaveRecord& w) override {
-    auto known = [](bool found, double v) {
-      return found ? std::optional<double>(v) : std::nullopt;
-    };
-    notebook::WaveRow r;
-    r.step = w.step, r.time = w.time, r.stage = w.stage, r.name = w.name, r.type = w.type;
-    r.propagation_axis = w.propagation_axis, r.polarisation_axis = w.polarisation_axis;
-    r.frequency = w.frequency, r.amplitude = w.amplitude, r.dt = w.dt;
-    r.velocity_xcorr = known(w.velocity_xcorr > 0.0, w.velocity_xcorr);
-    r.velocity_first_break = known(w.velocity_first_break > 0.0, w.velocity_first_break);
-    r.source = w.source;
-    for (const auto& x : w.receivers) {
-      notebook::WaveRow::Receiver y;
-      y.distance = x.distance;
-      y.particles = static_cast<std::int64_t>(x.particles);
-      y.picked_samples = static_cast<std::int64_t>(x.picked_samples);
-      y.samples = x.samples;
-      y.xcorr_time = known(x.xcorr_found, x.xcorr_time);
-      y.xcorr_quality = known(x.xcorr_found, x.xcorr_quality);
-      y.first_break_time = known(x.first_break_found, x.first_break_time);
-      r.receivers.push_back(std::move(y));
-    }
-    w_.wave(r);
-  }
+  void wave(const rigs::WaveRecord& w) override { w_.wave(w); }
 
  private:
   notebook::RunWriter& w_;
@@ -98,7 +70,7 @@ class NotebookRecorder : public rigs::Recorder {
 
 int checkProtocol(const std::string& path) {
   try {
-    const auto c = checkedProtocol(path);
+    const auto c = rigs::checkProtocol(path);
     std::size_t given = 0, total = 0;
     for (const auto& row : c.settings.table()) {
       ++total;
@@ -117,21 +89,13 @@ int listKeys(const std::string& rig) {
   try {
     const auto& r = rigs::findRig(rig, "rocklab keys");
     std::cout << "Keys of " << r.name << " protocols (" << r.doc << "):\n"
-              << rigs::schemaOf(r).help() << "\nKey results a protocol can name in "
-              << "protocol.key_results (a prefix picks a test, copy or stage: test2.NAME, "
-                 "cored.NAME, stage3.NAME):\n"
-              << reports::keyResultHelp(r.name);
+              << rigs::schemaOf(r).help() << "\n"
+              << r.outputs().help();
     return 0;
   } catch (const protocol::ProtocolError& e) {
     std::cerr << e.what() << "\n";
     return 2;
   }
-}
-
-rigs::CheckedProtocol checkedProtocol(const std::string& path) {
-  rigs::CheckedProtocol c = rigs::checkProtocol(path);
-  reports::checkKeyResults(c.rig->name, c.settings);
-  return c;
 }
 
 RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& settings,
@@ -146,10 +110,9 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
   info.build_type = kBuildType;
   info.seed = settings.integer("protocol.seed");
   info.threads = static_cast<int>(settings.integer("numerics.threads"));
-  std::vector<notebook::ParamRow> params;
-  for (const auto& p : settings.table()) params.push_back({p.key, p.value, p.unit});
-  notebook::RunWriter writer(nb, info, params);
-  NotebookRecorder rec(writer);
+  notebook::RunWriter writer(nb, info, settings.table());
+  NotebookRecorder notebook_rec(writer);
+  rigs::CheckedRecorder rec(notebook_rec, rig.outputs(), std::string(rig.name));
 
   g_signal.store(0);
   std::signal(SIGINT, onSignal);
@@ -184,7 +147,7 @@ int runProtocol(const RunOptions& o) {
   // protocol writes nothing.
   rigs::CheckedProtocol c{nullptr, {}};
   try {
-    c = checkedProtocol(o.protocol);
+    c = rigs::checkProtocol(o.protocol);
   } catch (const protocol::ProtocolError& e) {
     std::cerr << e.what() << "\n";
     return 2;

@@ -20,9 +20,6 @@ struct RunOptions {
 int runProtocol(const RunOptions& o);
 int checkProtocol(const std::string& path);
 
-// A protocol file read and checked completely, its key results included; throws
-// protocol::ProtocolError.
-rigs::CheckedProtocol checkedProtocol(const std::string& path);
 struct RunOutcome {
   int code = 0;  // as runProtocol's
   std::int64_t run = 0;

@@ -119,8 +119,12 @@ int main(int argc, char** argv) {
       ->callback([&] {
         action = [] {
           for (const auto* law : rocklab::contactLaws()) {
-            std::cout << law->name << ": " << law->doc << "\n  reads: " << law->material_keys
-                      << "\n";
+            std::cout << law->name << ": " << law->doc << "\n  protocol keys (with "
+                      << "material.density_kg_per_m3, friction, damping_ratio):\n";
+            for (const auto& k : law->keys) {
+              std::cout << "    material." << k.field.key << " (" << k.field.unit.name
+                        << "): " << k.field.doc << "\n";
+            }
           }
           return 0;
         };

@@ -136,7 +136,7 @@ int studyAccuracy(const StudyOptions& o) {
   std::vector<protocol::Settings> runs;
   std::vector<std::string> labels;
   try {
-    c = checkedProtocol(o.protocol);
+    c = rigs::checkProtocol(o.protocol);
     if (c.settings.texts("protocol.key_results").empty()) {
       protocol::fail(c.settings, "protocol.key_results",
                      "the protocol names no key results: a study has nothing to compare "
@@ -254,7 +254,7 @@ int regressUpdate(const RegressUpdateOptions& o) {
   std::vector<rigs::CheckedProtocol> checked;
   try {
     for (const std::string& p : o.protocols) {
-      checked.push_back(checkedProtocol(p));
+      checked.push_back(rigs::checkProtocol(p));
       if (checked.back().settings.texts("protocol.key_results").empty()) {
         protocol::fail(checked.back().settings, "protocol.key_results",
                        "the protocol names no key results: there is nothing to guard");
@@ -318,7 +318,7 @@ int regressUpdate(const RegressUpdateOptions& o) {
       const std::string quoted = key.find('.') == std::string::npos ? key : "\"" + key + "\"";
       file << "\n[results." << quoted << "]\nvalue = " << fmt(v.front())
            << "\ntolerance = " << fmt(tolerance) << "\nunit = \""
-           << reports::findKeyResult(c.rig->name, key)->unit << "\"\nseeds = [";
+           << c.rig->outputs().keyResult(key)->unit << "\"\nseeds = [";
       for (std::size_t k = 0; k < v.size(); ++k) file << (k ? ", " : "") << fmt(v[k]);
       file << "]\n";
     }

@@ -9,20 +9,23 @@
 
 namespace rocklab {
 
+BondKind BondKind::grains() {
+  BondKind k;
+  k.name = "grain";
+  k.intragranular = true;
+  k.modulus = 8.0 * kGPa;
+  k.stiffness_ratio = 1.0;
+  k.tensile_mean = k.shear_mean = 40.0 * kMPa;
+  k.tensile_std = k.shear_std = 0.0;
+  k.negative = NegativeStrength::Resample;
+  return k;
+}
+
 void BondKind::validate() const {
-  const std::string where = "bond kind '" + name + "'";
-  requireRange(where, "modulus", modulus, 0.0, true, INFINITY, true, "Pa");
-  requireRange(where, "stiffness_ratio", stiffness_ratio, 0.0, true, INFINITY, true, "-");
-  requireRange(where, "radius_multiplier", radius_multiplier, 0.0, true, 10.0, false, "-");
-  requireRange(where, "tensile_std", tensile_std, 0.0, false, INFINITY, true, "Pa");
-  requireRange(where, "shear_std", shear_std, 0.0, false, INFINITY, true, "Pa");
-  requireRange(where, "friction_angle", friction_angle, 0.0, false, std::numbers::pi / 2, true,
-               "rad");
-  requireRange(where, "moment_factor", moment_factor, 0.0, false, 1.0, false, "-");
-  // A mean at or below zero with Resample would loop for ever drawing a positive strength.
-  const double lo = negative == NegativeStrength::Resample ? 0.0 : -INFINITY;
-  requireRange(where, "tensile_mean", tensile_mean, lo, true, INFINITY, true, "Pa");
-  requireRange(where, "shear_mean", shear_mean, lo, true, INFINITY, true, "Pa");
+  if (negative == NegativeStrength::Resample && (tensile_mean <= 0.0 || shear_mean <= 0.0)) {
+    throw InvalidParameter("", "negative_strength",
+                           "resample needs positive mean strengths (it draws until positive)");
+  }
 }
 
 template <int D>

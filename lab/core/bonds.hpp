@@ -13,6 +13,7 @@
 
 #include "lab/core/contact_kernels.hpp"
 #include "lab/core/dim.hpp"
+#include "lab/core/fields.hpp"
 #include "lab/core/particles.hpp"
 
 namespace rocklab {
@@ -26,18 +27,20 @@ enum class NegativeStrength : std::uint8_t { Skip, Resample };
 
 enum class BondBreakMode : std::uint8_t { Tensile, Shear };
 
-// A family of bonds with their properties: intergranular cement here, intragranular bonds
-// of breakable grains later.
+// A family of bonds with their properties. The defaults are the paper's cement (section
+// 1.1: bond modulus 4 GPa, kn/ks 0.5, strengths 8 +- 8 MPa); `grains()` gives those of the
+// intragranular bonds of breakable grains (section 2.2). One declaration serves both
+// protocol sections, `bonds.*` and `grain_bonds.*`.
 struct BondKind {
   std::string name = "cement";
   bool intragranular = false;
-  double modulus = 0.0;            // Pa, bond modulus E: normal stiffness per area kn = E / L
-  double stiffness_ratio = 1.0;    // -, kn / ks of the bond
-  double radius_multiplier = 1.0;  // -, lambda
-  double tensile_mean = 0.0;       // Pa
-  double tensile_std = 0.0;        // Pa
-  double shear_mean = 0.0;         // Pa
-  double shear_std = 0.0;          // Pa
+  double modulus = 4.0 * kGPa;       // Pa, bond modulus E: normal stiffness per area kn = E / L
+  double stiffness_ratio = 0.5;      // -, kn / ks of the bond
+  double radius_multiplier = 1.0;    // -, lambda
+  double tensile_mean = 8.0 * kMPa;  // Pa
+  double tensile_std = 8.0 * kMPa;   // Pa
+  double shear_mean = 8.0 * kMPa;    // Pa
+  double shear_std = 8.0 * kMPa;     // Pa
   // rad, phi: under a compressive normal stress sigma_n = Fn / A the shear strength is
   // c + sigma_n tan(phi), c the drawn shear strength (Mohr-Coulomb; Potyondy 2015, the
   // linear parallel bond's pb_fa). A tensile normal stress leaves it at c: tension is the
@@ -51,7 +54,43 @@ struct BondKind {
   double moment_factor = 1.0;
   NegativeStrength negative = NegativeStrength::Skip;
 
-  void validate() const;  // throws InvalidParameter
+  // The intragranular bonds of breakable grains: stiffer and stronger than the cement, and
+  // never missing (a grain is not born cracked: draws <= 0 are drawn again).
+  static BondKind grains();
+
+  template <class F>
+  void fields(F& f) {
+    static constexpr Choice<NegativeStrength> kNegative[] = {
+        {"skip", NegativeStrength::Skip}, {"resample", NegativeStrength::Resample}};
+    // Strengths reach 1e5 MPa, beyond any rock's: an unbreakable bond is a legitimate choice
+    // (benchmarks, and tests of one failure mode alone).
+    const Range strength = Range::closed(-1e5, 1e5), spread = Range::closed(0, 1e5);
+    f(modulus, {"modulus_GPa", units::GPa, Range::leftOpen(0, 1e4),
+                "bond modulus E, normal stiffness per area kn = E / L (L = r1 + r2)"});
+    f(stiffness_ratio,
+      {"stiffness_ratio", units::none, Range::leftOpen(0, 100), "kn / ks of the bonds"});
+    f(radius_multiplier, {"radius_multiplier", units::none, Range::leftOpen(0, 10),
+                          "bond radius over the smaller particle radius"});
+    f(tensile_mean, {"tensile_strength_mean_MPa", units::MPa, strength, "mean tensile strength"});
+    f(tensile_std, {"tensile_strength_std_MPa", units::MPa, spread, "tensile strength std"});
+    f(shear_mean, {"shear_strength_mean_MPa", units::MPa, strength, "mean shear strength"});
+    f(shear_std, {"shear_strength_std_MPa", units::MPa, spread, "shear strength std"});
+    f(friction_angle,
+      {"friction_angle_deg", units::deg, Range::closed(0, 85),
+       "bond friction angle: under a compressive normal stress sigma_n the shear strength is "
+       "the drawn one plus sigma_n tan(angle) (PFC 5 pb_fa); 0: independent of load"});
+    f(moment_factor, {"moment_factor", units::none, Range::closed(0, 1),
+                      "share of the bending and twisting moments in the bond's peak stresses "
+                      "(PFC 5 pb_mcf); 1: the full beam stresses"});
+    f(negative,
+      {"negative_strength",
+       units::text,
+       {},
+       "a strength drawn <= 0: skip (no bond: it would break unloaded) or resample"},
+      kNegative);
+  }
+  // A mean at or below zero with Resample would loop for ever drawing a positive strength.
+  void validate() const;
   template <class Archive>
   void visit(Archive& ar) {
     ar("name", name), ar("intragranular", intragranular), ar("modulus", modulus);

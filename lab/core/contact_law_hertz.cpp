@@ -9,13 +9,7 @@ namespace rocklab {
 namespace {
 
 void validate(const MaterialTable& m) {
-  for (const Material& a : m.all()) {
-    const std::string where = "material '" + a.name + "' (hertz contact law)";
-    requireRange(where, "young", a.young, 0.0, true, INFINITY, true, "Pa");
-    requireRange(where, "poisson", a.poisson, -1.0, true, 0.5, false, "-");
-    requireRange(where, "friction", a.friction, 0.0, false, INFINITY, true, "-");
-    requireRange(where, "damping_ratio", a.damping_ratio, 0.0, false, 1.0, true, "-");
-  }
+  for (const Material& a : m.all()) checkMaterialKeys(a, kHertzLawEntry);
 }
 
 // Effective moduli of two elastic bodies in contact (Johnson 1985, ch. 4 and 7):
@@ -44,7 +38,10 @@ const ContactLawEntry kHertzLawEntry{
     "hertz",
     "Hertz normal force, Mindlin no-slip tangential stiffness, Coulomb friction, Tsuji "
     "dashpots by damping ratio (2D disks use the sphere formula, as PFC2D does)",
-    "young (Pa), poisson (-), friction (-), damping_ratio (-)",
+    {{&Material::young,
+      {"young_GPa", units::GPa, Range::leftOpen(0, 1e4), "hertz: Young's modulus of the grains"}},
+     {&Material::poisson,
+      {"poisson", units::none, Range::leftOpen(-1, 0.5), "hertz: Poisson's ratio of the grains"}}},
     validate,
     make<2>,
     make<3>,

@@ -8,20 +8,22 @@ namespace rocklab {
 
 namespace {
 
+// The stiffness comes from particle springs (kn, ks: library settings, the paper's PFC 3
+// style), from a contact modulus (a protocol's `material.contact_modulus_GPa`), or both.
 void validate(const MaterialTable& m) {
   for (const Material& a : m.all()) {
     const std::string where = "material '" + a.name + "' (linear contact law)";
     requireRange(where, "kn", a.kn, 0.0, false, INFINITY, true, "N/m");
-    requireRange(where, "modulus", a.modulus, 0.0, false, INFINITY, true, "Pa");
-    if (a.modulus > 0.0) {
-      requireRange(where, "stiffness_ratio", a.stiffness_ratio, 0.0, true, INFINITY, true, "-");
+    requireRange(where, "ks", a.ks, 0.0, false, INFINITY, true, "N/m");
+    // A modulus of 0 leaves the springs alone (its declared range is the protocol's, > 0).
+    if (a.modulus != 0.0) {
+      checkMaterialKeys(a, kLinearLawEntry);
+    } else {
+      checkFields(a, where);
     }
     if (!(a.kn > 0.0) && !(a.modulus > 0.0)) {
       throw InvalidParameter(where, "kn", a.kn, "(0, inf) or a modulus > 0", "N/m");
     }
-    requireRange(where, "ks", a.ks, 0.0, false, INFINITY, true, "N/m");
-    requireRange(where, "friction", a.friction, 0.0, false, INFINITY, true, "-");
-    requireRange(where, "damping_ratio", a.damping_ratio, 0.0, false, 1.0, true, "-");
   }
 }
 
@@ -55,8 +57,12 @@ const ContactLawEntry kLinearLawEntry{
     "linear",
     "linear normal and shear springs: particle springs in series and/or a contact modulus "
     "(kn = E A / L), Coulomb friction, dashpots by critical damping ratio",
-    "kn (N/m), ks (N/m) and/or modulus (Pa), stiffness_ratio (-); friction (-), "
-    "damping_ratio (-)",
+    {{&Material::modulus,
+      {"contact_modulus_GPa", units::GPa, Range::leftOpen(0, 1e4),
+       "linear: contact modulus E, kn = E A / L per contact (PFC 5 deformability)"}},
+     {&Material::stiffness_ratio,
+      {"stiffness_ratio", units::none, Range::leftOpen(0, 100),
+       "linear: kn / ks of the contacts"}}},
     validate,
     make<2>,
     make<3>,

@@ -126,9 +126,7 @@ double feretAspectRatio(const ClumpShape<D>& shape) {
 template <int D>
 ClumpShape<D> makeGrainShape(double length, const GrainShapeSpec& spec, Rng& rng) {
   const std::string where = "grain shape";
-  requireRange(where, "pebbles_across", spec.pebbles_across, 2, false, 20, false, "pebbles");
-  requireRange(where, "max_aspect_ratio", spec.max_aspect_ratio, 1.0, true, 10.0, false, "-");
-  requireRange(where, "roughness", spec.roughness, 0.0, false, 0.5, false, "-");
+  checkFields(spec, where);
   requireRange(where, "length", length, 0.0, true, INFINITY, true, "m");
   const double rp = length / (2.0 * spec.pebbles_across), s = 2.0 * rp;
   const double reach = 0.5 * length - rp;  // pebble centres within: calipers <= length
@@ -196,7 +194,7 @@ ClumpShape<D> makeGrainShape(double length, const GrainShapeSpec& spec, Rng& rng
 template <int D>
 GrainPacking<D> generateGrainPacking(const GrainPackingSpec& spec, PackingReport* report) {
   const std::string where = "grain packing";
-  spec.sizes.validate();
+  checkFields(spec.sizes, "size distribution");
   requireRange(where, "grains", static_cast<double>(spec.grains), 1, false, 1e7, false, "grains");
   requireRange(where, "porosity", spec.porosity, 0.0, true, 1.0, true, "-");
   requireRange(where, "thickness", spec.thickness, 0.0, true, INFINITY, true, "m");

@@ -20,8 +20,18 @@ namespace rocklab {
 
 struct GrainShapeSpec {
   int pebbles_across = 4;         // pebbles along a grain's long axis
-  double max_aspect_ratio = 1.5;  // -, longest over shortest caliper, exclusive
+  double max_aspect_ratio = 1.5;  // -, longest over shortest caliper, exclusive (Li & Holt 2.2)
   double roughness = 0.15;        // -, relative amplitude of the outline's perturbation
+
+  template <class F>
+  void fields(F& f) {
+    f(pebbles_across,
+      {"pebbles_across", units::none, Range::closed(2, 20), "pebbles along a grain's long axis"});
+    f(max_aspect_ratio, {"max_aspect_ratio", units::none, Range::leftOpen(1, 10),
+                         "longest over shortest caliper of every grain, exclusive"});
+    f(roughness, {"roughness", units::none, Range::closed(0, 0.5),
+                  "relative amplitude of the outline's bumps"});
+  }
 };
 
 // Longest over shortest caliper (Feret) diameter of the union of the pebbles, over 180

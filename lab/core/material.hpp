@@ -9,21 +9,35 @@
 #include <utility>
 #include <vector>
 
+#include "lab/core/fields.hpp"
+
 namespace rocklab {
 
-// Parameters a contact law may read. Each law declares which ones it needs (see
-// contact_laws.hpp) and validates them before a run starts.
+// Parameters a contact law may read. Each law declares the ones of its own a protocol sets
+// (contact_laws.hpp) and validates them before a run starts; the common ones are declared
+// here. The defaults are quartz grains (Hertz) and the paper's linear contacts (a contact
+// modulus of 4 GPa, section 1.1).
 struct Material {
   std::string name = "default";
   double density = 2650.0;       // kg/m^3, for scene builders: particles carry their own
-  double young = 70e9;           // Pa, Hertz-Mindlin
+  double young = 70.0 * kGPa;    // Pa, Hertz-Mindlin
   double poisson = 0.25;         // -, Hertz-Mindlin
   double kn = 0.0;               // N/m, linear: the particle's normal spring, in series per contact
   double ks = 0.0;               // N/m, linear: shear spring, in series per contact
-  double modulus = 0.0;          // Pa, linear: contact modulus E, kn = E A / L per contact
+  double modulus = 4.0 * kGPa;   // Pa, linear: contact modulus E, kn = E A / L per contact; 0: none
   double stiffness_ratio = 1.0;  // -, linear with a modulus: kn / ks
   double friction = 0.5;         // -, Coulomb coefficient
   double damping_ratio = 0.0;    // -, critical damping ratio of the contact dashpots
+
+  // The fields every law reads (the protocol's `material.*` keys beside the law's own).
+  template <class F>
+  void fields(F& f) {
+    f(density, {"density_kg_per_m3", units::kg_per_m3, Range::closed(1, 1e5), "grain density"});
+    f(friction, {"friction", units::none, Range::closed(0, 10),
+                 "grain-grain Coulomb friction after formation"});
+    f(damping_ratio, {"damping_ratio", units::none, Range::rightOpen(0, 1),
+                      "critical damping ratio of contact dashpots"});
+  }
 
   template <class Archive>
   void visit(Archive& ar) {

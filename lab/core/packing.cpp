@@ -41,21 +41,22 @@ SizeDistribution SizeDistribution::phiGaussian(double phi_mean, double phi_std, 
 }
 
 void SizeDistribution::validate() const {
-  const std::string where = "size distribution";
-  requireRange(where, "d_min", d_min, 0.0, true, INFINITY, true, "m");
-  requireRange(where, "d_max", d_max, d_min, false, INFINITY, true, "m");
-  switch (kind) {
-    case Kind::Uniform:
-      break;
-    case Kind::Normal:
-      requireRange(where, "d_mean", d_mean, d_min, false, d_max, false, "m");
-      requireRange(where, "d_std", d_std, 0.0, false, INFINITY, true, "m");
-      break;
-    case Kind::PhiGaussian:
-      requireRange(where, "phi_mean", phi_mean, phiOfDiameter(d_max), false, phiOfDiameter(d_min),
-                   false, "phi");
-      requireRange(where, "phi_std", phi_std, 0.0, false, INFINITY, true, "phi");
-      break;
+  auto mm = [](double d) { return Range::formatNumber(d / kmm); };
+  if (d_max < d_min) {
+    throw InvalidParameter("", "d_max_mm", d_max / kmm, "[d_min_mm = " + mm(d_min) + ", 10000]",
+                           "mm");
+  }
+  const std::string bounds = "[" + mm(d_min) + ", " + mm(d_max) + "]";
+  if (kind == Kind::Normal && (d_mean < d_min || d_mean > d_max)) {
+    throw InvalidParameter("", "d_mean_mm", d_mean / kmm, bounds + " (d_min_mm, d_max_mm)", "mm");
+  }
+  const double phi_lo = phiOfDiameter(d_max), phi_hi = phiOfDiameter(d_min);
+  if (kind == Kind::PhiGaussian && (phi_mean < phi_lo || phi_mean > phi_hi)) {
+    // The mean diameter 2^-phi_mean mm must lie within the bounds.
+    throw InvalidParameter("", "phi_mean", phi_mean,
+                           "[" + Range::formatNumber(phi_lo) + ", " + Range::formatNumber(phi_hi) +
+                               "] (the phi of d_max_mm and d_min_mm)",
+                           "phi");
   }
 }
 
@@ -170,6 +171,7 @@ Simulation<D> expansionScene(double r_mean, double thickness, double friction, i
   // not by the stiffness.
   Material m;
   m.name = "expansion";
+  m.modulus = 0.0;  // springs only
   m.kn = 1e8 * (D == 3 ? r_mean : thickness);
   m.ks = 0.5 * m.kn;
   m.friction = friction;
@@ -179,6 +181,7 @@ Simulation<D> expansionScene(double r_mean, double thickness, double friction, i
   mats.add(m);
   SimulationConfig cfg;
   cfg.contact_law = "linear";
+  cfg.skin_ratio = 0.1;
   cfg.local_damping = 0.7;
   cfg.threads = threads;
   cfg.track_energy = false;
@@ -229,10 +232,7 @@ void growAndRelax(Simulation<D>& sim, double s0, const std::function<void(double
 template <int D>
 Packing<D> generatePacking(const PackingSpec& spec, PackingReport* report) {
   const std::string where = "packing";
-  spec.sizes.validate();
-  requireRange(where, "count", static_cast<double>(spec.count), 1, false, 5e7, false, "particles");
-  requireRange(where, "porosity", spec.porosity, 0.0, true, 1.0, true, "-");
-  requireRange(where, "thickness", spec.thickness, 0.0, true, INFINITY, true, "m");
+  checkFields(spec, where);
   requireRange(where, "friction", spec.friction, 0.0, false, INFINITY, true, "-");
   for (int d = 0; d < D; ++d) {
     requireRange(where, "aspect", spec.aspect[d], 0.0, true, INFINITY, true, "-");

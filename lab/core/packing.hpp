@@ -9,19 +9,22 @@
 #include <vector>
 
 #include "lab/core/dim.hpp"
+#include "lab/core/fields.hpp"
 #include "lab/core/random.hpp"
 
 namespace rocklab {
 
+// Particle diameters. The defaults are a sand's: Gaussian in phi about 1 mm (phi 0, sd 0.5),
+// truncated to [0.5, 2] mm.
 struct SizeDistribution {
   enum class Kind { Uniform, Normal, PhiGaussian };
-  Kind kind = Kind::Uniform;
-  double d_min = 0.0;     // m; uniform: lower bound; normal and phi: draws below are redrawn
-  double d_max = 0.0;     // m; likewise the upper bound
-  double d_mean = 0.0;    // m, normal
-  double d_std = 0.0;     // m, normal
-  double phi_mean = 0.0;  // phi units, phi-Gaussian: phi = -log2(d / 1 mm)
-  double phi_std = 0.0;   // phi units
+  Kind kind = Kind::PhiGaussian;
+  double d_min = 0.5 * kmm;   // m; uniform: lower bound; normal and phi: draws below are redrawn
+  double d_max = 2.0 * kmm;   // m; likewise the upper bound
+  double d_mean = 1.0 * kmm;  // m, normal
+  double d_std = 0.2 * kmm;   // m, normal
+  double phi_mean = 0.0;      // phi units, phi-Gaussian: phi = -log2(d / 1 mm)
+  double phi_std = 0.5;       // phi units
 
   static SizeDistribution uniform(double d_min, double d_max);
   static SizeDistribution normal(double mean, double std, double d_min, double d_max);
@@ -29,9 +32,31 @@ struct SizeDistribution {
 
   // A diameter (m). Draws outside [d_min, d_max] are redrawn (truncated distributions).
   double sample(Rng& rng) const;
-  // Throws InvalidParameter for impossible settings.
-  void validate() const;
   std::string describe() const;
+
+  template <class F>
+  void fields(F& f) {
+    static constexpr Choice<Kind> kKinds[] = {
+        {"uniform", Kind::Uniform}, {"normal", Kind::Normal}, {"phi", Kind::PhiGaussian}};
+    const Range size = Range::leftOpen(0, 1e4);
+    f(kind,
+      {"size_distribution",
+       units::text,
+       {},
+       "diameters uniform in [d_min, d_max], normal(d_mean, d_std), or Gaussian in "
+       "phi = -log2(d / 1 mm); normal and phi are truncated to [d_min, d_max]"},
+      kKinds);
+    f(d_min, {"d_min_mm", units::mm, size, "smallest diameter"});
+    f(d_max, {"d_max_mm", units::mm, size, "largest diameter"});
+    f(d_mean, {"d_mean_mm", units::mm, size, "mean diameter (normal)"});
+    f(d_std,
+      {"d_std_mm", units::mm, Range::closed(0, 1e4), "diameter standard deviation (normal)"});
+    f(phi_mean, {"phi_mean", units::phi, Range::closed(-20, 20), "mean of phi (phi)"});
+    f(phi_std, {"phi_std", units::phi, Range::closed(0, 10), "standard deviation of phi (phi)"});
+  }
+  // The bounds in order and the mean inside them (throws InvalidParameter); the ranges of
+  // the fields are checked with them by checkFields.
+  void validate() const;
 };
 
 // phi = -log2(d / 1 mm) and back (Krumbein's phi scale of grain size).
@@ -53,6 +78,17 @@ struct PackingSpec {
   int threads = 1;
   // Called now and then with the fraction done (at most 1); may throw to abandon the work.
   std::function<void(double)> progress;
+
+  // The fields a protocol sets (its `sample.*` section; the box's aspect is the rig's).
+  template <class F>
+  void fields(F& f) {
+    f(count, {"count", units::none, Range::closed(2, 5e7),
+              "number of particles (grains for kind = grains)", true});
+    f.section("", sizes);
+    f(porosity, {"porosity_initial", units::none, Range::closed(0.05, 0.9),
+                 "porosity the packing is generated at (radius expansion), before formation"});
+    f(thickness, {"thickness_m", units::m, Range::leftOpen(0, 1e3), "disk thickness (2D)"});
+  }
 };
 
 template <int D>

@@ -149,12 +149,6 @@ void Simulation<D>::scaleRadii(double factor) {
 }
 
 template <int D>
-void Simulation<D>::setThreads(int threads) {
-  if (threads < 1) throw std::invalid_argument("thread count must be at least 1");
-  config_.threads = threads;
-}
-
-template <int D>
 void Simulation<D>::setFixedTimeStep(double dt) {
   requireRange("time step", "dt", dt, 0.0, true, INFINITY, true, "s");
   config_.timestep.automatic = false;
@@ -185,12 +179,9 @@ Simulation<D> Simulation<D>::clone() const {
 template <int D>
 void Simulation<D>::prepare() {
   const std::string where = "simulation settings";
-  requireRange(where, "local_damping", config_.local_damping, 0.0, false, 1.0, true, "-");
-  requireRange(where, "timestep.safety", config_.timestep.safety, 0.0, true, 1.0, false, "-");
+  checkFields(config_, where);
   requireRange(where, "timestep.update_interval", config_.timestep.update_interval, 1, false, 1e9,
                false, "steps");
-  requireRange(where, "guard.overlap_limit", config_.guard.overlap_limit, 0.0, true, 1.0, false,
-               "-");
   requireRange(where, "guard.energy_growth", config_.guard.energy_growth, 1.0, true, INFINITY, true,
                "-");
   requireRange(where, "skin", config_.skin, 0.0, false, INFINITY, true, "m");
@@ -219,8 +210,9 @@ void Simulation<D>::prepare() {
   if (contacts_.skin <= 0.0) {
     double rsum = 0.0;
     for (double r : particles_.radius) rsum += r;
-    contacts_.skin =
-        config_.skin > 0.0 ? config_.skin : 0.1 * rsum / static_cast<double>(particles_.size());
+    contacts_.skin = config_.skin > 0.0
+                         ? config_.skin
+                         : config_.skin_ratio * (rsum / static_cast<double>(particles_.size()));
   }
   if (config_.local_damping > 0.0) {
     damp_force_.resize(particles_.size(), V::Zero());
@@ -333,7 +325,7 @@ template <int D>
 void Simulation<D>::computeBondForces(double dt) {
   const auto t0 = std::chrono::steady_clock::now();
   auto& P = particles_;
-  BondPass<D> pass{P,  bonds_, dt, threaded(),        config_.threads, config_.bond_breakage,
+  BondPass<D> pass{P,  bonds_, dt, threaded(),         config_.threads, config_.bond_breakage,
                    {}, {},     {}, config_.bond_lanes, &bond_kinds_};
   bond_forces_.compute(pass);
   if (!pass.broken.empty()) {
@@ -370,7 +362,7 @@ void Simulation<D>::computeBondForces(double dt) {
 
 template <int D>
 std::uint8_t Simulation<D>::addBondKind(BondKind kind) {
-  kind.validate();
+  checkFields(kind, "bond kind '" + kind.name + "'");
   if (bond_kinds_.size() >= 255) throw std::invalid_argument("at most 255 bond kinds");
   bond_kinds_.push_back(std::move(kind));
   broken_counts_.resize(2 * bond_kinds_.size(), 0);
@@ -1091,6 +1083,7 @@ template <int D>
 template <class Archive>
 void Simulation<D>::visit(Archive& ar) {
   ar("config.contact_law", config_.contact_law), ar("config.skin", config_.skin);
+  ar("config.skin_ratio", config_.skin_ratio);
   ar("config.local_damping", config_.local_damping);
   ar("config.timestep.automatic", config_.timestep.automatic);
   ar("config.timestep.fixed_dt", config_.timestep.fixed_dt);

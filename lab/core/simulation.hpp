@@ -20,8 +20,10 @@
 #include "lab/core/bond_forces.hpp"
 #include "lab/core/bonds.hpp"
 #include "lab/core/clumps.hpp"
+#include "lab/core/contact_laws.hpp"
 #include "lab/core/contact_model.hpp"
 #include "lab/core/contacts.hpp"
+#include "lab/core/fields.hpp"
 #include "lab/core/material.hpp"
 #include "lab/core/neighbors.hpp"
 #include "lab/core/particles.hpp"
@@ -44,10 +46,13 @@ struct GuardConfig {
   bool energy_runaway = true;
 };
 
+// The defaults are PFC's for quasi-static loading (local damping 0.7) and a Verlet skin of a
+// fifth of the mean radius; scenes that need otherwise (a collision, a wave) say so.
 struct SimulationConfig {
   std::string contact_law = "linear";
-  double skin = 0.0;           // m, Verlet skin; 0 picks 0.1 x the mean radius
-  double local_damping = 0.0;  // -, PFC local damping coefficient, 0 (off) to < 1
+  double skin = 0.0;           // m, Verlet skin; 0: skin_ratio times the mean radius
+  double skin_ratio = 0.2;     // -, the skin over the mean radius
+  double local_damping = 0.7;  // -, PFC local damping coefficient, 0 (off) to < 1
   TimeStepConfig timestep;
   GuardConfig guard;
   int threads = 1;           // OpenMP threads; results do not depend on it
@@ -60,6 +65,24 @@ struct SimulationConfig {
   // false: 3D bonds one at a time. The four-lane pass (bond_lanes.hpp) gives the same bits,
   // so this only changes the speed; the tests compare the two.
   bool bond_lanes = true;
+
+  // The fields a protocol sets, with their keys (the contact law in the material section).
+  template <class F>
+  void fields(F& f) {
+    f(contact_law, {"material.contact_law", units::text, {}, "contact law between grains"},
+      contactLawChoices());
+    f(timestep.safety, {"numerics.timestep_safety", units::none, Range::leftOpen(0, 1),
+                        "time step over the critical estimate"});
+    f(local_damping, {"numerics.local_damping", units::none, Range::rightOpen(0, 1),
+                      "PFC local damping coefficient"});
+    f(threads, {"numerics.threads", units::none, Range::closed(1, 1024),
+                "OpenMP threads; results do not depend on it"});
+    f(skin_ratio, {"numerics.skin_ratio", units::none, Range::leftOpen(0, 10),
+                   "Verlet skin over the mean radius"});
+    f(guard.overlap_limit,
+      {"numerics.overlap_limit", units::none, Range::leftOpen(0, 1),
+       "the run stops when an overlap exceeds this fraction of the smaller radius"});
+  }
 };
 
 // Energy exchanged since the ledger started (J).
@@ -156,7 +179,6 @@ class Simulation {
   // Scales every radius by `factor` (radius expansion); masses stay. Growth counts against
   // the neighbour skin like motion, so the list is rebuilt only when needed.
   void scaleRadii(double factor);
-  void setThreads(int threads);
   void setLocalDamping(double alpha) { config_.local_damping = alpha; }
   void setBondBreakage(bool on) { config_.bond_breakage = on; }
   void setFixedTimeStep(double dt);
@@ -183,8 +205,9 @@ class Simulation {
   const BondStore<D>& bonds() const { return bonds_; }
   // Bonds broken so far of a kind and mode.
   std::uint64_t brokenBonds(std::uint8_t kind, BondBreakMode mode) const;
-  // The breaks logged since the last call, oldest first (hands them to the notebook).
-  std::vector<BondBreak<D>> takeBondBreaks() { return std::exchange(bond_breaks_, {}); }
+  // Every bond break since the scene began, oldest first. Observers read on from where they
+  // stopped (their own cursor into it); reading changes nothing.
+  const std::vector<BondBreak<D>>& bondBreaks() const { return bond_breaks_; }
 
   // --- clumps (rigid bodies of pebbles) ---
   // Makes the given particles, all of one density, a rigid clump with their momentum and
@@ -198,7 +221,8 @@ class Simulation {
   const ClumpStore<D>& clumps() const { return clumps_; }
   // Breaks a clump into its pebbles, which keep the velocity they had in the body.
   void releaseClump(std::uint32_t clump);
-  std::vector<ClumpBreak<D>> takeClumpBreaks() { return std::exchange(clump_breaks_, {}); }
+  // Every clump break since the scene began, oldest first (as bondBreaks()).
+  const std::vector<ClumpBreak<D>>& clumpBreaks() const { return clump_breaks_; }
 
   // --- driven particles (a wave transmitter, DESIGN.md Waves) ---
   // Makes the particles at these slots driven: infinite mass and inertia, no spin, moving
@@ -251,8 +275,9 @@ class Simulation {
   // --- checkpoints ---
   void saveCheckpoint(const std::string& path) const;
   static Simulation loadCheckpoint(const std::string& path);
-  // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle and moment_factor.
-  static constexpr std::uint32_t kCheckpointVersion = 4;
+  // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle and moment_factor,
+  // 5 config.skin_ratio.
+  static constexpr std::uint32_t kCheckpointVersion = 5;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };

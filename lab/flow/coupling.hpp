@@ -38,6 +38,29 @@ struct FlowSettings {
   // bumps, not pores (trimHull).
   double trim_edge_ratio = 2.0;
   bool apply_forces = true;  // the pressures act on the particles
+
+  // The keys a protocol sets (its `flow.*` section; the axis is the rig's).
+  template <class F>
+  void fields(F& f) {
+    static constexpr Choice<FlowSolver> kSolvers[] = {{"implicit", FlowSolver::Implicit},
+                                                      {"explicit", FlowSolver::Explicit}};
+    f(pressures.inlet, {"pressure_drop_kPa", units::kPa, Range::leftOpen(0, 1e6),
+                        "inlet over outlet pressure (the outlet is the reference, 0)"});
+    f.section("", law);
+    f(solver,
+      {"solver",
+       units::text,
+       {},
+       "steady state by one sparse solve, or by the paper's explicit time stepping"},
+      kSolvers);
+    f.section("", implicit);
+    f.section("", explicit_scheme);
+    f.section("", merge);
+    f(retriangulate_displacement,
+      {"retriangulate_displacement_radii", units::none, Range::leftOpen(0, 100),
+       "triangulate anew once a particle has moved this many mean radii"});
+    f(apply_forces, {"apply_forces", units::text, {}, "the pore pressures act on the particles"});
+  }
 };
 
 struct FlowReading {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lab/core/dim.hpp"
+#include "lab/core/fields.hpp"
 #include "lab/flow/triangulation.hpp"
 
 namespace rocklab::flow {
@@ -29,7 +30,15 @@ enum class PoreBoundary : std::uint8_t { Free = 0, Inlet = 1, Outlet = 2 };
 
 struct ConductanceLaw {
   double alpha = 1.0;         // -, equation 3's factor (1: Hagen-Poiseuille)
-  double viscosity = 1.0e-3;  // Pa s
+  double viscosity = 1.0e-3;  // Pa s (water)
+
+  template <class F>
+  void fields(F& f) {
+    f(viscosity,
+      {"viscosity_mPa_s", units::mPa_s, Range::leftOpen(0, 1e9), "fluid viscosity (water: 1)"});
+    f(alpha, {"conductance_alpha", units::none, Range::leftOpen(0, 1e6),
+              "alpha of equation 3, C = alpha pi r_e^4 / (8 mu r_av) (1: Hagen-Poiseuille)"});
+  }
 };
 
 template <int D>
@@ -105,7 +114,17 @@ struct MergeRule {
   // Merge a pore whose own critical step v / (K_f sum C) is below this times the median into
   // the neighbour it is best connected to (0: never). Flat cells have next to no volume and
   // would drive the explicit step to zero (equation 6).
-  double small_pore_ratio = 0.0;
+  double small_pore_ratio = 0.01;
+
+  template <class F>
+  void fields(F& f) {
+    f(conductance_ratio, {"merge_conductance_ratio", units::none, Range::closed(0, 1e9),
+                          "merge the pores of a pipe whose conductance exceeds this times the "
+                          "median (Figure 7b; 0: off)"});
+    f(small_pore_ratio, {"merge_small_pore_ratio", units::none, Range::rightOpen(0, 1),
+                         "merge a pore whose own explicit step is below this times the median "
+                         "into its best connected neighbour (flat cells; 0: off)"});
+  }
 };
 
 // Groups the pores; a cluster never joins an inlet pore to an outlet pore.

@@ -53,6 +53,20 @@ enum class ImplicitMethod { Cholesky, ConjugateGradient };
 struct ImplicitSettings {
   ImplicitMethod method = ImplicitMethod::Cholesky;
   double tolerance = 1e-12;  // relative residual for conjugate gradients
+
+  template <class F>
+  void fields(F& f) {
+    static constexpr Choice<ImplicitMethod> kMethods[] = {
+        {"cholesky", ImplicitMethod::Cholesky}, {"cg", ImplicitMethod::ConjugateGradient}};
+    f(method,
+      {"implicit_method",
+       units::text,
+       {},
+       "sparse LDL^T, or conjugate gradients with incomplete Cholesky"},
+      kMethods);
+    f(tolerance, {"implicit_tolerance", units::none, Range::leftOpen(0, 1e-2),
+                  "conjugate gradients' relative residual"});
+  }
 };
 
 SteadyFlow solveImplicit(const Clusters& c, const Pressures& bc, const ImplicitSettings& s,
@@ -61,9 +75,28 @@ SteadyFlow solveImplicit(const Clusters& c, const Pressures& bc, const ImplicitS
 struct ExplicitSettings {
   double fluid_modulus = 2.2e9;  // Pa, K_f (water)
   double dt = 0.0;               // s; 0: the critical step
-  bool virtual_volume = false;   // equation 7: v = K_f dt sum C instead of the real volume
-  double tolerance = 1e-9;       // stop when every pore's imbalance is below this
-  std::size_t max_steps = 2000000;
+  bool virtual_volume = true;    // equation 7: v = K_f dt sum C instead of the real volume
+  double tolerance = 1e-12;      // stop when every pore's imbalance is below this
+  std::size_t max_steps = 1000000;
+
+  template <class F>
+  void fields(F& f) {
+    f(fluid_modulus, {"fluid_bulk_modulus_GPa", units::GPa, Range::leftOpen(0, 1e3),
+                      "K_f of equation 5 (water: 2.2)"});
+    f(dt, {"explicit_timestep_s", units::s, Range::closed(0, 1e6),
+           "explicit step (0: the critical step of equation 6; larger is refused)"});
+    f(virtual_volume, {"virtual_volume",
+                       units::text,
+                       {},
+                       "explicit scheme with the virtual pore volumes of equation 7 (steady "
+                       "state only)"});
+    f(tolerance, {"explicit_tolerance", units::none, Range::leftOpen(0, 1e-2),
+                  "the explicit scheme stops when every pore's imbalance is below this "
+                  "(relative to its conductances times the drop)"});
+    f(max_steps, {"explicit_max_steps", units::none, Range::closed(1, 1e10),
+                  "explicit steps before giving up (the paper's scheme converges like Jacobi "
+                  "iterations: slowly on long networks)"});
+  }
 };
 
 // Starts from `previous` (per cluster; empty: the mean of the two boundary pressures).

@@ -312,7 +312,7 @@ void RunWriter::snapshot(std::string_view kind, std::string_view stage, std::str
   s.bind(7, relative).run();
 }
 
-std::int64_t RunWriter::wave(const WaveRow& w) {
+std::int64_t RunWriter::wave(const WaveRecord& w) {
   auto& db = nb_.db();
   Transaction tx(db);
   auto ws = db.prepare(
@@ -330,7 +330,7 @@ std::int64_t RunWriter::wave(const WaveRow& w) {
   auto ps = db.prepare(
       "INSERT INTO picks (wave_id, receiver, method, time_s, quality) VALUES (?, ?, ?, ?, ?)");
   for (std::size_t r = 0; r < w.receivers.size(); ++r) {
-    const WaveRow::Receiver& x = w.receivers[r];
+    const WaveRecord::Receiver& x = w.receivers[r];
     const auto index = static_cast<std::int64_t>(r);
     ts.bind(1, wave_id).bind(2, index).bind(3, x.distance).bind(4, x.particles);
     ts.bind(5, x.picked_samples).bindDoubles(6, x.samples).run();
@@ -359,7 +359,7 @@ void RunWriter::series(std::string_view name, std::uint64_t step, double time, d
   flushIfDue();
 }
 
-void RunWriter::event(const EventRow& e) {
+void RunWriter::event(const EventRecord& e) {
   events_.push_back(e);
   flushIfDue();
 }
@@ -396,7 +396,7 @@ void RunWriter::flush() {
     auto s = db.prepare(
         "INSERT INTO events (run_id, step, time_s, kind, mode, x, y, z, particle_a, particle_b, "
         "granular, value, stage) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    for (const EventRow& e : events_) {
+    for (const EventRecord& e : events_) {
       s.bind(1, id_).bind(2, e.step).bind(3, e.time).bind(4, e.kind).bind(5, e.mode);
       s.bind(6, e.x).bind(7, e.y).bind(8, e.z).bind(9, e.particle_a).bind(10, e.particle_b);
       s.bind(11, e.granular).bind(12, e.value).bind(13, e.stage).run();

@@ -1,9 +1,8 @@
 #pragma once
 // The lab notebook: one SQLite database per lab holding every run, its parameters, time
-// series, events, stage timings and key results. The schema (DESIGN.md; the user-facing
-// SQL interface is documented in the README) carries its version in PRAGMA user_version
-// and is migrated forward on open. WAL journal, foreign keys on, writes batched in
-// transactions.
+// series, events, stage timings and key results (the records of records.hpp). The schema
+// (lab/notebook/README.md) carries its version in PRAGMA user_version and is migrated
+// forward on open. WAL journal, foreign keys on, writes batched in transactions.
 
 #include <cstdint>
 #include <memory>
@@ -12,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "lab/notebook/records.hpp"
 #include "lab/notebook/sqlite.hpp"
 
 namespace rocklab::notebook {
@@ -54,44 +54,6 @@ struct RunInfo {
   int threads = 1;
 };
 
-struct ParamRow {
-  std::string key, value, unit;
-};
-
-struct EventRow {
-  std::uint64_t step = 0;
-  double time = 0.0;
-  std::string stage;  // the protocol stage, e.g. formation, loading, cored
-  std::string kind;   // e.g. bond_break
-  std::string mode;   // e.g. tensile, shear
-  double x = 0.0, y = 0.0, z = 0.0;
-  std::int64_t particle_a = -1, particle_b = -1;
-  std::string granular;  // inter or intra
-  double value = 0.0;    // e.g. the stress that broke the bond (Pa)
-};
-
-// One ultrasonic measurement (the `waves`, `traces` and `picks` tables): a pulse sent through
-// a copy of the sample at a loading stage, the receivers' traces and their arrival picks.
-struct WaveRow {
-  std::uint64_t step = 0;  // the loading step whose state was copied
-  double time = 0.0;
-  std::string stage;  // e.g. "stage 3"
-  std::string name;   // pz, px, szx, sxy
-  std::string type;   // P or S
-  int propagation_axis = 0, polarisation_axis = 0;
-  double frequency = 0.0, amplitude = 0.0, dt = 0.0;           // Hz, m/s, s
-  std::optional<double> velocity_xcorr, velocity_first_break;  // m/s
-  std::vector<double> source;                                  // m/s, every dt
-  struct Receiver {
-    double distance = 0.0;  // m
-    std::int64_t particles = 0;
-    std::int64_t picked_samples = 0;  // samples before the far end's echo
-    std::vector<double> samples;      // m/s, every dt
-    std::optional<double> xcorr_time, xcorr_quality, first_break_time;  // s, -, s
-  };
-  std::vector<Receiver> receivers;
-};
-
 // Records one run. Rows are buffered and written in batched transactions (flush() or
 // automatically past a batch size); finish() writes the rest and closes the run with its
 // status. A writer destroyed without finish() marks the run failed.
@@ -104,12 +66,12 @@ class RunWriter {
 
   std::int64_t id() const { return id_; }
   void series(std::string_view name, std::uint64_t step, double time, double value);
-  void event(const EventRow& e);
+  void event(const EventRecord& e);
   void message(std::uint64_t step, double time, std::string_view level, std::string_view text);
   void result(std::string_view name, double value, std::string_view unit);
   void stageTiming(std::string_view stage, double seconds, std::uint64_t calls);
   // Writes a wave with its traces and picks at once (one transaction); returns its id.
-  std::int64_t wave(const WaveRow& w);
+  std::int64_t wave(const WaveRecord& w);
   // Writes a file of the run (a state frame, kind "frame") and records it in `snapshots`.
   void snapshot(std::string_view kind, std::string_view stage, std::string_view label,
                 std::uint64_t step, double time, const std::string& bytes,
@@ -131,7 +93,7 @@ class RunWriter {
   Notebook& nb_;
   std::int64_t id_ = 0;
   std::vector<Series> series_;
-  std::vector<EventRow> events_;
+  std::vector<EventRecord> events_;
   std::vector<Message> messages_;
   struct Result {
     std::string name;

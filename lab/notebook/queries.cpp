@@ -103,7 +103,30 @@ Table eventsOf(Notebook& nb, std::int64_t run, const std::string& kind) {
   return drain(s);
 }
 
-std::vector<WaveRow> wavesOf(Notebook& nb, std::int64_t run) {
+std::vector<EventRecord> eventRecords(Notebook& nb, std::int64_t run, const std::string& kind) {
+  requireRun(nb, run);
+  auto s = nb.db().prepare(
+      "SELECT step, time_s, coalesce(stage, ''), kind, coalesce(mode, ''), x, y, z, particle_a, "
+      "particle_b, coalesce(granular, ''), value FROM events WHERE run_id = ? AND kind = ? "
+      "ORDER BY rowid");
+  s.bind(1, run).bind(2, kind);
+  std::vector<EventRecord> out;
+  while (s.step()) {
+    EventRecord e;
+    e.step = static_cast<std::uint64_t>(s.integer(0));
+    e.time = s.real(1);
+    e.stage = s.text(2), e.kind = s.text(3), e.mode = s.text(4);
+    e.x = s.real(5), e.y = s.real(6), e.z = s.real(7);
+    e.particle_a = s.isNull(8) ? -1 : s.integer(8);
+    e.particle_b = s.isNull(9) ? -1 : s.integer(9);
+    e.granular = s.text(10);
+    e.value = s.real(11);
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+std::vector<WaveRecord> wavesOf(Notebook& nb, std::int64_t run) {
   requireRun(nb, run);
   auto ws = nb.db().prepare(
       "SELECT id, step, time_s, stage, name, wave_type, propagation_axis, polarisation_axis, "
@@ -121,9 +144,9 @@ std::vector<WaveRow> wavesOf(Notebook& nb, std::int64_t run) {
   auto optional = [](const Statement& s, int c) {
     return s.isNull(c) ? std::nullopt : std::optional<double>(s.real(c));
   };
-  std::vector<WaveRow> out;
+  std::vector<WaveRecord> out;
   while (ws.step()) {
-    WaveRow w;
+    WaveRecord w;
     w.step = static_cast<std::uint64_t>(ws.integer(1));
     w.time = ws.real(2);
     w.stage = ws.text(3), w.name = ws.text(4), w.type = ws.text(5);
@@ -135,7 +158,7 @@ std::vector<WaveRow> wavesOf(Notebook& nb, std::int64_t run) {
     w.source = ws.doubles(13);
     ts.bind(1, ws.integer(0));
     while (ts.step()) {
-      WaveRow::Receiver r;
+      WaveRecord::Receiver r;
       r.distance = ts.real(0);
       r.particles = ts.integer(1);
       r.picked_samples = ts.integer(2);

@@ -20,8 +20,10 @@ Table listRuns(Notebook& nb);
 std::vector<std::pair<std::string, Table>> showRun(Notebook& nb, std::int64_t run);
 Table seriesOf(Notebook& nb, std::int64_t run, const std::vector<std::string>& names);
 Table eventsOf(Notebook& nb, std::int64_t run, const std::string& kind);
+// The run's events of one kind, in the order recorded.
+std::vector<EventRecord> eventRecords(Notebook& nb, std::int64_t run, const std::string& kind);
 // The run's ultrasonic measurements with their traces and picks, in the order recorded.
-std::vector<WaveRow> wavesOf(Notebook& nb, std::int64_t run);
+std::vector<WaveRecord> wavesOf(Notebook& nb, std::int64_t run);
 // Throws when the run does not exist, naming the lab.
 void requireRun(Notebook& nb, std::int64_t run);
 

@@ -13,10 +13,7 @@ namespace {
 using TomlValue = toml::basic_value<toml::discard_comments, std::map, std::vector>;
 
 std::string number(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
+  return Range::formatNumber(v);
 }
 
 std::string show(const Value& v) {
@@ -58,13 +55,11 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
 }
 
 bool inRange(const ParamDecl& d, double v) {
-  const bool lo = d.lo_open ? v > d.lo : v >= d.lo;
-  const bool hi = d.hi_open ? v < d.hi : v <= d.hi;
-  return lo && hi && v == v;
+  return d.range.contains(v);
 }
 
 std::string unitText(const ParamDecl& d) {
-  return d.unit.empty() ? "" : " (" + d.unit + ")";
+  return d.unit.name.empty() ? "" : " (" + std::string(d.unit.name) + ")";
 }
 
 }  // namespace
@@ -76,7 +71,7 @@ std::string ParamDecl::rangeText() const {
     return s;
   }
   if (kind == Kind::Text || kind == Kind::Flag || kind == Kind::TextList) return "";
-  return std::string(lo_open ? "(" : "[") + number(lo) + ", " + number(hi) + (hi_open ? ")" : "]");
+  return range.text();
 }
 
 ParamDecl& Schema::add(ParamDecl d) {
@@ -85,61 +80,14 @@ ParamDecl& Schema::add(ParamDecl d) {
   return decls_.back();
 }
 
-ParamDecl& Schema::real(const std::string& key, const std::string& unit, double to_si,
-                        std::optional<double> fallback, const std::string& doc) {
-  ParamDecl d;
-  d.key = key, d.kind = Kind::Real, d.unit = unit, d.to_si = to_si, d.doc = doc;
-  if (fallback) d.fallback = *fallback;
-  return add(std::move(d));
-}
-
-ParamDecl& Schema::integer(const std::string& key, std::optional<std::int64_t> fallback,
-                           const std::string& doc) {
-  ParamDecl d;
-  d.key = key, d.kind = Kind::Integer, d.unit = "-", d.doc = doc;
-  if (fallback) d.fallback = *fallback;
-  return add(std::move(d));
-}
-
-ParamDecl& Schema::text(const std::string& key, std::optional<std::string> fallback,
-                        const std::string& doc) {
-  ParamDecl d;
-  d.key = key, d.kind = Kind::Text, d.doc = doc;
-  if (fallback) d.fallback = *fallback;
-  return add(std::move(d));
-}
-
-ParamDecl& Schema::choice(const std::string& key, std::vector<std::string> choices,
-                          std::optional<std::string> fallback, const std::string& doc) {
-  ParamDecl d;
-  d.key = key, d.kind = Kind::Choice, d.choices = std::move(choices), d.doc = doc;
-  if (fallback) d.fallback = *fallback;
-  return add(std::move(d));
-}
-
-ParamDecl& Schema::flag(const std::string& key, std::optional<bool> fallback,
-                        const std::string& doc) {
-  ParamDecl d;
-  d.key = key, d.kind = Kind::Flag, d.doc = doc;
-  if (fallback) d.fallback = *fallback;
-  return add(std::move(d));
-}
-
-ParamDecl& Schema::realList(const std::string& key, const std::string& unit, double to_si,
-                            std::optional<std::vector<double>> fallback, const std::string& doc) {
-  ParamDecl d;
-  d.key = key, d.kind = Kind::RealList, d.unit = unit, d.to_si = to_si, d.doc = doc;
-  if (fallback) d.fallback = *fallback;
-  return add(std::move(d));
-}
-
-ParamDecl& Schema::textList(const std::string& key,
-                            std::optional<std::vector<std::string>> fallback,
-                            const std::string& doc) {
-  ParamDecl d;
-  d.key = key, d.kind = Kind::TextList, d.doc = doc;
-  if (fallback) d.fallback = *fallback;
-  return add(std::move(d));
+void Schema::setChoices(const std::string& key, std::vector<std::string> choices) {
+  for (ParamDecl& d : decls_) {
+    if (d.key != key) continue;
+    d.kind = Kind::Choice;
+    d.choices = std::move(choices);
+    return;
+  }
+  throw std::logic_error("setChoices: no key " + key);
 }
 
 void Schema::addForeign(const std::string& key, const std::string& rig) {
@@ -199,9 +147,6 @@ const Value& Settings::value(const std::string& key) const {
 double Settings::real(const std::string& key) const {
   return std::get<double>(value(key));
 }
-double Settings::si(const std::string& key) const {
-  return real(key) * decl(key).to_si;
-}
 std::int64_t Settings::integer(const std::string& key) const {
   return std::get<std::int64_t>(value(key));
 }
@@ -211,15 +156,9 @@ const std::string& Settings::text(const std::string& key) const {
 bool Settings::flag(const std::string& key) const {
   return std::get<bool>(value(key));
 }
-std::vector<double> Settings::list(const std::string& key) const {
+const std::vector<double>& Settings::list(const std::string& key) const {
   return std::get<std::vector<double>>(value(key));
 }
-std::vector<double> Settings::listSi(const std::string& key) const {
-  std::vector<double> v = list(key);
-  for (double& x : v) x *= decl(key).to_si;
-  return v;
-}
-
 const std::vector<std::string>& Settings::texts(const std::string& key) const {
   return std::get<std::vector<std::string>>(value(key));
 }
@@ -229,10 +168,11 @@ std::string Settings::where(const std::string& key) const {
   return file_ + (it == given_.end() ? "" : ":" + std::to_string(it->second));
 }
 
-std::vector<ParamRow> Settings::table() const {
-  std::vector<ParamRow> rows;
-  for (const ParamDecl& d : schema_->all())
-    rows.push_back({d.key, show(values_.at(d.key)), d.unit});
+std::vector<notebook::ParamRow> Settings::table() const {
+  std::vector<notebook::ParamRow> rows;
+  for (const ParamDecl& d : schema_->all()) {
+    rows.push_back({d.key, show(values_.at(d.key)), std::string(d.unit.name)});
+  }
   return rows;
 }
 
@@ -296,6 +236,7 @@ void Settings::overrideText(const std::string& key, const std::string& text) {
 }
 
 void fail(const Settings& s, const std::string& key, const std::string& why) {
+  s.decl(key);  // a key no schema declares is the caller's mistake, not the protocol's
   throw ProtocolError({s.where(key) + ": " + key + ": " + why});
 }
 

@@ -1,10 +1,11 @@
 #pragma once
-// Protocol parameters, each declared once: its dotted key (the unit is part of the name,
-// e.g. `formation.axial_stress_MPa`), kind, unit, default (none: required), allowed range
-// and a one-line doc. The declarations validate protocol files, print the help text and
-// fill the notebook's parameter table.
+// Protocol files: TOML checked against a schema of keys. Each key's declaration (its dotted
+// key with the unit in its name, e.g. `formation.axial_stress_MPa`, its kind, unit,
+// default, allowed range and one-line doc) comes from the settings struct that owns it
+// (lab/core/fields.hpp; declare.hpp builds the schema and reads the structs back). The
+// schema validates protocol files, prints `rocklab keys` and fills the notebook's parameter
+// table.
 
-#include <cmath>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -14,46 +15,38 @@
 #include <variant>
 #include <vector>
 
+#include "lab/core/fields.hpp"
+#include "lab/notebook/records.hpp"
+
 namespace rocklab::protocol {
 
 enum class Kind { Real, Integer, Text, Choice, Flag, RealList, TextList };
 
+// A value in the key's unit (numbers are converted to SI only when read into a struct).
 using Value = std::variant<double, std::int64_t, std::string, bool, std::vector<double>,
                            std::vector<std::string>>;
 
 struct ParamDecl {
   std::string key;
   Kind kind = Kind::Real;
-  std::string unit;               // as in the key name: "MPa", "1/s", "-"; empty for text
-  double to_si = 1.0;             // factor from the key's unit to SI (MPa: 1e6)
+  Unit unit = units::none;
   std::optional<Value> fallback;  // the default; none means required
-  double lo = -INFINITY, hi = INFINITY;
-  bool lo_open = false, hi_open = false;
+  Range range;                    // numbers and the elements of a list of numbers
   std::vector<std::string> choices;
   std::string doc;
 
   std::string rangeText() const;  // e.g. "(0, 1]" or "one of: skip, resample"
 };
 
-// A set of declarations; builders return the declaration to refine.
 class Schema {
  public:
-  ParamDecl& real(const std::string& key, const std::string& unit, double to_si,
-                  std::optional<double> fallback, const std::string& doc);
-  ParamDecl& integer(const std::string& key, std::optional<std::int64_t> fallback,
-                     const std::string& doc);
-  ParamDecl& text(const std::string& key, std::optional<std::string> fallback,
-                  const std::string& doc);
-  ParamDecl& choice(const std::string& key, std::vector<std::string> choices,
-                    std::optional<std::string> fallback, const std::string& doc);
-  ParamDecl& flag(const std::string& key, std::optional<bool> fallback, const std::string& doc);
-  ParamDecl& realList(const std::string& key, const std::string& unit, double to_si,
-                      std::optional<std::vector<double>> fallback, const std::string& doc);
-  ParamDecl& textList(const std::string& key, std::optional<std::vector<std::string>> fallback,
-                      const std::string& doc);
-
+  // Throws std::logic_error for a key declared twice.
+  ParamDecl& add(ParamDecl d);
   const ParamDecl* find(const std::string& key) const;
   const std::vector<ParamDecl>& all() const { return decls_; }
+  // Narrows a text key to a list of names known only where the schema is assembled (the
+  // rigs of `protocol.rig`).
+  void setChoices(const std::string& key, std::vector<std::string> choices);
 
   // The rig these keys are for, and the keys other rigs use for effects this one cannot
   // (a wave source, pore fluid, ...): a protocol giving one is told which rig it belongs to.
@@ -66,17 +59,10 @@ class Schema {
   std::string help() const;
 
  private:
-  ParamDecl& add(ParamDecl d);
   std::vector<ParamDecl> decls_;
   std::string rig_;
   std::vector<std::pair<std::string, std::string>> foreign_;  // key, rig
 };
-
-// Range helpers for declarations.
-inline ParamDecl& range(ParamDecl& d, double lo, bool lo_open, double hi, bool hi_open) {
-  d.lo = lo, d.lo_open = lo_open, d.hi = hi, d.hi_open = hi_open;
-  return d;
-}
 
 // Every problem found in a protocol file, one per line: "file:line: key ...".
 class ProtocolError : public std::runtime_error {
@@ -88,28 +74,20 @@ class ProtocolError : public std::runtime_error {
   std::vector<std::string> problems_;
 };
 
-struct ParamRow {
-  std::string key, value, unit;
-};
-
-// The validated values of a protocol.
+// The validated values of a protocol, in the units their keys name.
 class Settings {
  public:
-  // In the unit the key names (e.g. MPa for `..._MPa`).
   double real(const std::string& key) const;
-  // Converted to SI.
-  double si(const std::string& key) const;
   std::int64_t integer(const std::string& key) const;
-  const std::string& text(const std::string& key) const;
+  const std::string& text(const std::string& key) const;  // texts and choices
   bool flag(const std::string& key) const;
-  std::vector<double> list(const std::string& key) const;  // in the key's unit
-  std::vector<double> listSi(const std::string& key) const;
+  const std::vector<double>& list(const std::string& key) const;
   const std::vector<std::string>& texts(const std::string& key) const;
   bool given(const std::string& key) const { return given_.count(key) > 0; }
   // Where a key was set, for errors found across keys ("file:line").
   std::string where(const std::string& key) const;
   // Every parameter with its value (given or default) and unit.
-  std::vector<ParamRow> table() const;
+  std::vector<notebook::ParamRow> table() const;
   const std::string& file() const { return file_; }
   // Replaces a value after parsing (a command-line override); the range is checked.
   void override(const std::string& key, Value v);
@@ -117,12 +95,12 @@ class Settings {
   // key's kind; lists cannot be given this way.
   void overrideText(const std::string& key, const std::string& text);
   bool declared(const std::string& key) const;
+  const ParamDecl& decl(const std::string& key) const;  // throws std::logic_error if undeclared
   const std::string& source() const { return source_; }
 
  private:
   friend Settings parseProtocol(const std::string&, const std::string&, const Schema&);
   const Value& value(const std::string& key) const;
-  const ParamDecl& decl(const std::string& key) const;
   std::shared_ptr<const Schema> schema_;  // owned: settings outlive the schema they came from
   std::string file_, source_;
   std::map<std::string, Value> values_;
@@ -134,7 +112,7 @@ class Settings {
 // values out of range) each naming the file, line, key, allowed range and unit.
 Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema);
 
-// A problem found across several keys, in the same format.
+// A problem found across several keys, in the same format ("file:line: key: why").
 [[noreturn]] void fail(const Settings& s, const std::string& key, const std::string& why);
 
 // Reads a whole file; throws naming it when unreadable.

@@ -31,12 +31,12 @@ bool biaxialLoading(const RunData& r) {
 Figure pressureField(const RunData& r) {
   const bool three_d = r.param("protocol.dimension") == "3";
   const bool normal = r.param("flow.direction") == "normal";
-  std::vector<const PoreRow*> pores;
+  std::vector<const notebook::EventRecord*> pores;
   double lo = 1e300, hi = -1e300, mid_lo = 1e300, mid_hi = -1e300;
-  for (const PoreRow& p : r.pores) {
+  for (const notebook::EventRecord& p : r.pores) {
     if (p.stage != "initial") continue;
     pores.push_back(&p);
-    lo = std::min(lo, p.pressure), hi = std::max(hi, p.pressure);
+    lo = std::min(lo, p.value), hi = std::max(hi, p.value);
     mid_lo = std::min(mid_lo, p.y), mid_hi = std::max(mid_hi, p.y);
   }
   Figure f;
@@ -61,12 +61,12 @@ Figure pressureField(const RunData& r) {
   }
   Series all{"pores", {}, {}, true};
   const double slab_mid = 0.5 * (mid_lo + mid_hi);
-  for (const PoreRow* p : pores) {
+  for (const notebook::EventRecord* p : pores) {
     const double height = three_d ? (normal ? p->x : p->z) : (normal ? p->x : p->y);
     all.x.push_back(height * 1e3);
-    all.y.push_back(p->pressure / 1e3);
+    all.y.push_back(p->value / 1e3);
     if (three_d && std::abs(p->y - slab_mid) > 1e-3) continue;
-    const int band = std::clamp(static_cast<int>((p->pressure - lo) / span * 5), 0, 4);
+    const int band = std::clamp(static_cast<int>((p->value - lo) / span * 5), 0, 4);
     map.series[band].x.push_back(p->x * 1e3);
     map.series[band].y.push_back((three_d ? p->z : p->y) * 1e3);
   }

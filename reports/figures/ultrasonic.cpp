@@ -96,8 +96,8 @@ Figure moduli(const RunData& r) {
 }
 
 // The last stage's waves.
-std::vector<const notebook::WaveRow*> lastStage(const RunData& r) {
-  std::vector<const notebook::WaveRow*> out;
+std::vector<const notebook::WaveRecord*> lastStage(const RunData& r) {
+  std::vector<const notebook::WaveRecord*> out;
   if (r.waves.empty()) return out;
   const std::string& stage = r.waves.back().stage;
   for (const auto& w : r.waves) {
@@ -120,7 +120,7 @@ Figure traces(const RunData& r) {
       "the source pulse at distance 0. Markers: cross-correlation picks (the time the source "
       "pulse best matches the trace) and first breaks; the velocity is the inverse slope of "
       "their times over distance. Traces end where the echo from the far end could arrive.";
-  for (const notebook::WaveRow* w : waves) {
+  for (const notebook::WaveRecord* w : waves) {
     if (w->receivers.size() < 2) continue;
     Panel p{"time (microseconds)", w->name + ": distance (mm)", {}};
     const double spacing = (w->receivers[1].distance - w->receivers[0].distance) * 1e3;
@@ -167,7 +167,7 @@ Figure spectra(const RunData& r) {
       "FFT amplitude of the source pulse, of the nearest receiver's trace and of the farthest "
       "one whose whole pulse arrives before the far end's echo, each normalised to its peak; "
       "the pulse's nominal frequency is the wave.frequency_kHz of the protocol.";
-  for (const notebook::WaveRow* w : lastStage(r)) {
+  for (const notebook::WaveRecord* w : lastStage(r)) {
     if (w->receivers.empty()) continue;
     Panel p{"frequency (kHz)", w->name + ": amplitude / peak", {}};
     const double f_max = 4.0 * w->frequency;  // a one-period pulse holds 99% below 3 f0
@@ -187,7 +187,7 @@ Figure spectra(const RunData& r) {
     // The farthest receiver whose whole pulse lies before the echo cut: a pulse cut in half
     // would show the cut's spectrum, not the pack's filtering.
     const double period = 1.0 / (w->frequency * w->dt);  // samples
-    const notebook::WaveRow::Receiver* far = nullptr;
+    const notebook::WaveRecord::Receiver* far = nullptr;
     for (const auto& rc : w->receivers) {
       if (rc.xcorr_time && *rc.xcorr_time / w->dt + 1.5 * period <= rc.picked_samples) far = &rc;
     }

@@ -3,32 +3,19 @@
 #include <algorithm>
 #include <sstream>
 
-#include "rigs/biaxial/loading.hpp"
+#include "rigs/common/formation.hpp"
+#include "rigs/common/measurements.hpp"
 
 namespace rocklab::rigs::envelope {
 
-using protocol::Settings;
-
-void declare(protocol::Schema& s) {
-  s.realList("envelope.confining_stresses_MPa", "MPa", 1e6, std::vector<double>{0, 4, 10, 18},
-             "confining stresses of the sweep, one test each (0: the UCS test)");
-  biaxial::declareLoading(s);
-}
-
-void validate(const Settings& s) {
-  biaxial::validateLoading(s);
-  const std::vector<double> c = s.list("envelope.confining_stresses_MPa");
-  if (c.size() < 2) {
-    protocol::fail(s, "envelope.confining_stresses_MPa",
-                   "needs at least two confinements for an envelope");
+void Settings::validate() const {
+  const std::string key = "envelope.confining_stresses_MPa";
+  if (confining_stresses.size() < 2) {
+    throw InvalidParameter("", key, "needs at least two confinements for an envelope");
   }
-  for (std::size_t i = 0; i < c.size(); ++i) {
-    if (c[i] < 0.0 || c[i] > 1e4) {
-      protocol::fail(s, "envelope.confining_stresses_MPa",
-                     "holds " + std::to_string(c[i]) + ": each must lie in [0, 10000] (MPa)");
-    }
-    if (i > 0 && c[i] <= c[i - 1]) {
-      protocol::fail(s, "envelope.confining_stresses_MPa", "must rise strictly");
+  for (std::size_t i = 1; i < confining_stresses.size(); ++i) {
+    if (confining_stresses[i] <= confining_stresses[i - 1]) {
+      throw InvalidParameter("", key, "must rise strictly");
     }
   }
 }
@@ -37,17 +24,18 @@ namespace {
 
 template <int D>
 void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
-  Specimen<D> formed = buildSpecimen<D>(s, control);
+  Specimen<D> formed = buildSpecimen<D>(s.specimen, control);
   biaxial::recordSample(formed, rec);
-  formAndCement(formed, s, rec, control);
-  const std::vector<double> sweep = s.listSi("envelope.confining_stresses_MPa");
+  formAndCement(formed, rec, control);
+  const std::vector<double>& sweep = s.confining_stresses;
   std::vector<EnvelopePoint> points;
   std::vector<std::unique_ptr<Simulation<D>>> done;  // kept for the stage timings
   double highest_dilatant = -1.0, lowest_compactive = -1.0;
   for (std::size_t k = 0; k < sweep.size(); ++k) {
     Specimen<D> sp = formed.branch();
     const std::string branch = "test" + std::to_string(k + 1);
-    const biaxial::TestOutcome t = biaxial::confineAndLoad(sp, s, sweep[k], branch, rec, control);
+    const biaxial::TestOutcome t =
+        biaxial::confineAndLoad(sp, s.test, s.analysis, sweep[k], branch, rec, control);
     done.push_back(std::move(sp.sim));
     if (!t.critical.found) continue;
     points.push_back({t.sigma3, t.sigma3 + t.critical.q, t.critical.compactive});
@@ -88,7 +76,8 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
 }  // namespace
 
 void run(const Settings& s, Recorder& rec, RunControl& control) {
-  byDimension(s, [&](auto dim) { runDimension<dim.value>(s, rec, control); });
+  byDimension(s.specimen.protocol.dimension,
+              [&](auto dim) { runDimension<dim.value>(s, rec, control); });
 }
 
 }  // namespace rocklab::rigs::envelope

@@ -1,19 +1,61 @@
 #pragma once
 // One loading test of the biaxial frame / triaxial cell, shared by the single-test rig
-// (`biaxial`) and the confinement sweep (`envelope`): confinement held by servo walls,
-// axial strain rate through the peak, the critical point and the failure band.
+// (`biaxial`), the confinement sweep (`envelope`) and the permeameter's biaxial mode:
+// confinement held by servo walls, axial strain rate through the peak, the critical point
+// and the failure band.
 
 #include <string>
 
 #include "rigs/common/envelope.hpp"
+#include "rigs/common/loading_keys.hpp"
 #include "rigs/common/specimen.hpp"
 
 namespace rocklab::rigs::biaxial {
 
-// The loading keys (rate, end of the test, localisation analysis), without the
-// confinement, which each rig declares its own way.
-void declareLoading(protocol::Schema& s);
-void validateLoading(const Settings& s);
+// The test's `loading.*` keys, without the confinement, which each rig declares its own way.
+struct LoadingTest {
+  double confining_rate = 2e4 * kMPa;  // Pa/s
+  double seating_stress = 0.1 * kMPa;  // Pa
+  double axial_strain_rate = 1.0;      // 1/s
+  double axial_strain_max = 0.05;
+  double stop_after_drop = 0.0;
+  double stop_after_drop_min_strain = 0.002;
+
+  template <class F>
+  void fields(F& f) {
+    f(confining_rate, {"confining_rate_MPa_per_s", units::MPa_per_s, Range::leftOpen(0, 1e12),
+                       "stress rate from the formation state to the confinement"});
+    f(seating_stress, {"seating_stress_MPa", units::MPa, Range::closed(0, 1e3),
+                       "axial stress above the confinement the platens keep before loading"});
+    f(axial_strain_rate, loading_keys::kAxialStrainRate);
+    f(axial_strain_max, loading_keys::kAxialStrainMax);
+    f(stop_after_drop, {"stop_after_drop", units::none, Range::closed(0, 1),
+                        "stop once the deviatoric stress has fallen this fraction below its peak "
+                        "(0: run to axial_strain_max)"});
+    f(stop_after_drop_min_strain,
+      {"stop_after_drop_min_strain", units::none, Range::closed(0, 0.9),
+       "the drop stops the test only past this axial strain: the first grains to break or "
+       "slip under a barely loaded sample make no peak"});
+  }
+  // A test that stops after the peak must get past it: a drop needs room to show.
+  void validate() const;
+};
+
+// The localisation analysis (`analysis.*`, rigs/common/localisation.hpp).
+struct BandAnalysis {
+  double band_width_radii = 8.0;
+  double strained_fraction = 0.15;
+
+  template <class F>
+  void fields(F& f) {
+    f(band_width_radii,
+      {"band_width_radii", units::none, Range::closed(1, 1e3),
+       "width of the trial band of the localisation analysis, in mean particle radii"});
+    f(strained_fraction, {"strained_fraction", units::none, Range::leftOpen(0, 1),
+                          "fraction of the particles, the most strained from the critical point "
+                          "to the end, in which the band of the strain field is sought"});
+  }
+};
 
 struct TestOutcome {
   double sigma3 = 0.0;     // Pa
@@ -24,10 +66,11 @@ struct TestOutcome {
 template <int D>
 void recordSample(const Specimen<D>& sp, Recorder& rec);
 
-// Servos the formed specimen to `sigma3` (plus the seating stress axially), then loads it.
-// Series, results and stages are prefixed with `branch` + "." when a branch is named.
+// Servos the formed specimen to `sigma3` (Pa; plus the seating stress axially), then loads
+// it. Series, results and stages are prefixed with `branch` + "." when a branch is named.
 template <int D>
-TestOutcome confineAndLoad(Specimen<D>& sp, const Settings& s, double sigma3,
-                           const std::string& branch, Recorder& rec, RunControl& control);
+TestOutcome confineAndLoad(Specimen<D>& sp, const LoadingTest& test, const BandAnalysis& analysis,
+                           double sigma3, const std::string& branch, Recorder& rec,
+                           RunControl& control);
 
 }  // namespace rocklab::rigs::biaxial

@@ -11,36 +11,12 @@
 #include <vector>
 
 #include "lab/core/frame.hpp"
+#include "lab/notebook/records.hpp"
 
 namespace rocklab::rigs {
 
-struct EventRecord {
-  std::uint64_t step = 0;
-  double time = 0.0;
-  std::string stage, kind, mode, granular;
-  double x = 0.0, y = 0.0, z = 0.0;
-  std::int64_t particle_a = -1, particle_b = -1;
-  double value = 0.0;
-};
-
-// An ultrasonic measurement (rigs/ultrasonic): the pulse, each receiver's trace and picks.
-struct WaveRecord {
-  std::uint64_t step = 0;  // the loading step whose state was copied
-  double time = 0.0;
-  std::string stage, name, type;  // e.g. "stage 3", "pz", "P"
-  int propagation_axis = 0, polarisation_axis = 0;
-  double frequency = 0.0, amplitude = 0.0, dt = 0.0;        // Hz, m/s, s
-  double velocity_xcorr = 0.0, velocity_first_break = 0.0;  // m/s, 0: none
-  std::vector<double> source;                               // m/s, every dt
-  struct Receiver {
-    double distance = 0.0;  // m
-    std::size_t particles = 0, picked_samples = 0;
-    std::vector<double> samples;  // m/s, every dt
-    bool xcorr_found = false, first_break_found = false;
-    double xcorr_time = 0.0, xcorr_quality = 0.0, first_break_time = 0.0;
-  };
-  std::vector<Receiver> receivers;
-};
+using notebook::EventRecord;
+using notebook::WaveRecord;
 
 class Recorder {
  public:

@@ -5,62 +5,28 @@
 #include <sstream>
 
 #include "rigs/common/analysis.hpp"
-#include "rigs/common/specimen.hpp"
+#include "rigs/common/formation.hpp"
+#include "rigs/common/measurements.hpp"
 
 namespace rocklab::rigs::oedometer {
 
-using protocol::range;
-using protocol::Settings;
-
-void declare(protocol::Schema& s) {
-  s.choice("loading.control", {"strain_rate", "stress_ramp"}, "strain_rate",
-           "drive the axial walls at a strain rate, or servo them along a stress ramp");
-  range(s.real("loading.axial_strain_rate_per_s", "1/s", 1, 5.0,
-               "axial strain rate (strain_rate control); its inertial number is checked"),
-        0, true, 1e6, false);
-  range(s.real("loading.axial_strain_max", "-", 1, 0.03,
-               "axial strain since formation at which loading stops"),
-        0, true, 0.9, false);
-  range(s.real("loading.axial_stress_rate_MPa_per_s", "MPa/s", 1e6, 1e5,
-               "axial stress rate (stress_ramp control)"),
-        0, true, 1e12, false);
-  range(s.real("loading.axial_stress_max_MPa", "MPa", 1e6, 100.0,
-               "axial stress at which a stress ramp stops"),
-        0, true, 1e5, false);
-  range(s.realList("loading.cycle_at_axial_strain", "-", 1, std::vector<double>{},
-                   "axial strains at which the axial stress is cycled: unloaded, then reloaded"),
-        0, true, 0.9, false);
-  range(s.real("loading.cycle_unload_fraction", "-", 1, 0.5,
-               "each cycle unloads this fraction of the axial stress gained since formation "
-               "(below 1: a cycle never unloads past the formation state, which would core)"),
-        0, true, 1, false);
-  s.flag("coring.enabled", false,
-         "also core the formed sample (unload to near zero stress, reload) and test it beside "
-         "the virgin one");
-  range(s.real("coring.unload_to_MPa", "MPa", 1e6, 0.5, "the stress coring unloads to, all axes"),
-        0, true, 1e4, false);
-  range(s.real("coring.stress_rate_MPa_per_s", "MPa/s", 1e6, 2e4,
-               "stress rate of the coring unload and the reload"),
-        0, true, 1e12, false);
-}
-
-void validate(const Settings& s) {
-  const auto cycles = s.list("loading.cycle_at_axial_strain");
-  if (!cycles.empty() && s.text("loading.control") != "strain_rate") {
-    protocol::fail(s, "loading.cycle_at_axial_strain", "cycles need loading.control = strain_rate");
+void Settings::validate() const {
+  const std::string cycles = "loading.cycle_at_axial_strain";
+  const auto& at = cycle_at_axial_strain;
+  if (!at.empty() && control != Control::StrainRate) {
+    throw InvalidParameter("", cycles, "cycles need loading.control = strain_rate");
   }
-  for (std::size_t k = 0; k < cycles.size(); ++k) {
-    if (cycles[k] >= s.real("loading.axial_strain_max")) {
-      protocol::fail(s, "loading.cycle_at_axial_strain",
-                     "every cycle strain must be below loading.axial_strain_max");
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    if (at[k] >= axial_strain_max) {
+      throw InvalidParameter("", cycles,
+                             "every cycle strain must be below loading.axial_strain_max");
     }
-    if (k > 0 && cycles[k] <= cycles[k - 1]) {
-      protocol::fail(s, "loading.cycle_at_axial_strain", "cycle strains must increase");
-    }
+    if (k > 0 && at[k] <= at[k - 1])
+      throw InvalidParameter("", cycles, "cycle strains must increase");
   }
-  if (s.flag("coring.enabled") &&
-      s.real("coring.unload_to_MPa") >= s.real("formation.lateral_stress_MPa")) {
-    protocol::fail(s, "coring.unload_to_MPa", "coring must unload below the formation stresses");
+  if (coring && coring_unload_to >= specimen.formation.lateral_stress) {
+    throw InvalidParameter("", "coring.unload_to_MPa",
+                           "coring must unload below the formation stresses");
   }
 }
 
@@ -99,12 +65,14 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
   auto& frame = *sp.frame;
   const std::string stage = branch.empty() ? "loading" : branch;
   const std::string prefix = branch.empty() ? "" : branch + ".";
-  const bool strain_control = s.text("loading.control") == "strain_rate";
-  const double rate = s.real("loading.axial_strain_rate_per_s");
-  const double strain_max = s.real("loading.axial_strain_max");
-  const double stress_max = s.si("loading.axial_stress_max_MPa");
-  const std::vector<double> cycle_at = s.list("loading.cycle_at_axial_strain");
-  const double unload_fraction = s.real("loading.cycle_unload_fraction");
+  const bool strain_control = s.control == Control::StrainRate;
+  const double rate = s.axial_strain_rate;
+  const double strain_max = s.axial_strain_max;
+  const double stress_max = s.axial_stress_max;
+  const std::vector<double>& cycle_at = s.cycle_at_axial_strain;
+  const double unload_fraction = s.cycle_unload_fraction;
+  const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
+  const auto snapshot_every = static_cast<std::uint64_t>(sp.settings.output.snapshot_every_steps);
 
   for (int a = 0; a < D; ++a) {
     if (a != ax) frame.set(a, Axis{Mode::Fixed});
@@ -114,7 +82,7 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
   if (strain_control) {
     frame.set(ax, Axis{Mode::StrainRate, rate});
   } else {
-    frame.set(ax, Axis{Mode::Stress, 0.0, sigma0, s.si("loading.axial_stress_rate_MPa_per_s")});
+    frame.set(ax, Axis{Mode::Stress, 0.0, sigma0, s.axial_stress_rate});
   }
 
   std::vector<Sample> pts;
@@ -170,12 +138,12 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
     const bool finished = strain_control ? strain >= strain_max : stress >= stress_max;
     if (finished) {
       record();
-      snapshot(sp, s, rec, stage, "final");
+      snapshot(sp, rec, stage, "final");
       break;
     }
-    if ((sim.steps() - start) % sp.record_every == 0) record();
-    if (sp.snapshot_every && (sim.steps() - start) % sp.snapshot_every == 0) {
-      snapshot(sp, s, rec, stage, "step " + std::to_string(sim.steps() - start));
+    if ((sim.steps() - start) % record_every == 0) record();
+    if (snapshot_every && (sim.steps() - start) % snapshot_every == 0) {
+      snapshot(sp, rec, stage, "step " + std::to_string(sim.steps() - start));
     }
     if (sim.steps() % 100 == 0) {
       const double fraction =
@@ -234,16 +202,16 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
   put("mean_unbalanced_force_ratio", mean_unbalanced, "");
   if (strain_control) put("max_inertial_number", inertial_max, "");
 
-  warnIfNotQuasiStatic(sim, s, rec, stage, mean_unbalanced, strain_control ? inertial_max : 0.0);
+  warnIfNotQuasiStatic(sp, rec, stage, mean_unbalanced, strain_control ? inertial_max : 0.0);
   return e0;
 }
 
 template <int D>
 void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
-  Specimen<D> sp = buildSpecimen<D>(s, control);
+  Specimen<D> sp = buildSpecimen<D>(s.specimen, control);
   rec.result("particles", static_cast<double>(sp.sim->particles().size()), "");
-  formAndCement(sp, s, rec, control);
-  if (!s.flag("coring.enabled")) {
+  formAndCement(sp, rec, control);
+  if (!s.coring) {
     loadOedometric(sp, s, rec, control, "");
     recordTimings<D>(rec, {sp.sim.get()});
     return;
@@ -252,14 +220,14 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   const double virgin_modulus = loadOedometric(virgin, s, rec, control, "virgin");
 
   constexpr int ax = Specimen<D>::kAxial;
-  const double rate = s.si("coring.stress_rate_MPa_per_s");
-  const double low = s.si("coring.unload_to_MPa");
-  servoTo(sp, s, low, low, rate, "coring", rec, control);
+  const double rate = s.coring_stress_rate;
+  const double low = s.coring_unload_to;
+  servoTo(sp, low, low, rate, "coring", rec, control);
   rec.result(
       "broken_bonds_by_coring",
       static_cast<double>(sp.broken(BondBreakMode::Tensile) + sp.broken(BondBreakMode::Shear)), "");
-  servoTo(sp, s, s.si("formation.axial_stress_MPa"), s.si("formation.lateral_stress_MPa"), rate,
-          "reloading", rec, control);
+  const FormationSettings& formed = s.specimen.formation;
+  servoTo(sp, formed.axial_stress, formed.lateral_stress, rate, "reloading", rec, control);
   rec.result("axial_strain_after_coring_and_reloading", sp.frame->strain(ax), "");
   sp.frame->resetReference();
   sp.resetBrokenCount();
@@ -271,7 +239,8 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
 }  // namespace
 
 void run(const Settings& s, Recorder& rec, RunControl& control) {
-  byDimension(s, [&](auto dim) { runDimension<dim.value>(s, rec, control); });
+  byDimension(s.specimen.protocol.dimension,
+              [&](auto dim) { runDimension<dim.value>(s, rec, control); });
 }
 
 }  // namespace rocklab::rigs::oedometer

@@ -4,119 +4,25 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "lab/signal/signal.hpp"
-#include "rigs/common/specimen.hpp"
+#include "rigs/common/formation.hpp"
+#include "rigs/common/measurements.hpp"
 #include "rigs/ultrasonic/wave.hpp"
 
 namespace rocklab::rigs::ultrasonic {
 
-using protocol::range;
-using protocol::Settings;
-
-void declare(protocol::Schema& s) {
-  s.choice("loading.mode", {"hydrostatic", "uniaxial-strain", "triaxial"}, "hydrostatic",
-           "the loading the waves are measured along: every wall servoed to one stress; lateral "
-           "walls fixed and an axial strain rate; or a confining stress and an axial strain rate");
-  s.realList("loading.stages_MPa", "MPa", 1e6, std::vector<double>{1, 2, 4, 8},
-             "hydrostatic: the stresses, ascending, at which waves are measured");
-  s.realList("loading.stages_axial_strain", "-", 1, std::vector<double>{0.001, 0.002, 0.003},
-             "uniaxial-strain and triaxial: the axial strains, ascending, at which waves are "
-             "measured; loading ends at the last");
-  range(s.real("loading.stress_rate_MPa_per_s", "MPa/s", 1e6, 2e3,
-               "stress rate of the hydrostatic ramps and of the confinement"),
-        0, true, 1e12, false);
-  range(s.real("loading.confining_stress_MPa", "MPa", 1e6, 2.85,
-               "triaxial: lateral stress held by servo walls"),
-        0, false, 1e4, false);
-  range(s.real("loading.axial_strain_rate_per_s", "1/s", 1, 0.5,
-               "uniaxial-strain and triaxial: axial strain rate"),
-        0, true, 1e6, false);
-  range(s.real("wave.frequency_kHz", "kHz", 1e3, std::nullopt,
-               "frequency of the one-period sine velocity pulse; its wavelength should span "
-               "several grains (checked)"),
-        0, true, 1e9, false);
-  range(s.real("wave.amplitude_m_per_s", "m/s", 1, 1e-3,
-               "peak velocity of the source: small, so that contacts stay in their elastic range"),
-        0, true, 1e3, false);
-  range(s.real("wave.source_at", "-", 1, 0.1,
-               "source slab centre along the path, as a fraction of the sample from its low face"),
-        0, true, 1, false);
-  s.realList("wave.receivers_at", "-", 1, std::vector<double>{0.35, 0.5, 0.65, 0.8},
-             "receiver slab centres along the path, fractions of the sample, ascending");
-  range(s.real("wave.slab_diameters", "-", 1, 2.0,
-               "thickness of the source and receiver slabs, in mean particle diameters"),
-        0, true, 100, false);
-  range(s.real("wave.receiver_half_width", "-", 1, 0.5,
-               "receivers keep the particles within this fraction of the sample's smaller half "
-               "width of its axis (a disc in 3D)"),
-        0, true, 10, false);
-  range(s.real("wave.first_break_fraction", "-", 1, 0.1,
-               "first-break level, as a fraction of each trace's peak magnitude"),
-        0, true, 1, true);
-  range(s.integer("wave.sample_every_steps", 1,
-                  "the receivers' sampling: one sample every this many steps (1: every step; "
-                  "at least four samples per pulse period, checked)"),
-        1, false, 1e6, false);
-  range(s.integer("wave.max_window_steps", 200000,
-                  "longest recording of one wave; it stops earlier once the farthest receiver "
-                  "has heard the pulse"),
-        100, false, 1e9, false);
-  range(s.integer("wave.hold_steps", 20000,
-                  "most steps a copy is held at rest (walls still, damped) before its waves and "
-                  "static cycles"),
-        0, false, 1e9, false);
-  range(s.integer("wave.frames", 3,
-                  "wave-front frames of each wave at the last stage, one every pulse period "
-                  "(Figure 17)"),
-        0, false, 20, false);
-  s.flag("static.enabled", true,
-         "measure static moduli by small strain cycles (lateral walls held) at each stage");
-  // 1e-5 was lost in what is left of the unbalanced force at "rest": the loading and
-  // unloading slopes disagreed and fell with stress. At 1e-4 they agree within 2% (measured
-  // on ultrasonic-hydrostatic-quick), still a tenth of a Hertzian overlap at 0.5 MPa.
-  range(s.real("static.strain_amplitude", "-", 1, 1e-4,
-               "strain of the static cycle: small, to stay in the elastic range, but large "
-               "enough to stand out of the residual unbalanced force"),
-        0, true, 1e-2, false);
-  // The moduli come from rest states between the moves (each move is followed by a hold
-  // until the copy is at rest), so the rate only sets how long a move takes.
-  range(s.real("static.strain_rate_per_s", "1/s", 1, 1.0,
-               "strain rate of the static cycle's moves; the stresses are read at rest after "
-               "each"),
-        0, true, 1e6, false);
-}
-
-namespace {
-
-void requireAscending(const Settings& s, const std::string& key, double lo, double hi,
-                      const std::string& unit) {
-  const std::vector<double> v = s.list(key);
-  if (v.empty()) protocol::fail(s, key, "needs at least one value");
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (!(v[i] > lo && v[i] <= hi) || (i > 0 && !(v[i] > v[i - 1]))) {
-      protocol::fail(s, key, "must be ascending, in (" + fmt(lo) + ", " + fmt(hi) + "] " + unit);
-    }
+void Settings::validate() const {
+  if (specimen.sample.kind == SampleKind::Clumps) {
+    throw InvalidParameter("", "sample.kind", "must be spheres or grains on the ultrasonic bench");
   }
-}
-
-}  // namespace
-
-void validate(const Settings& s) {
-  // A clump's pebbles move with their body: they can be neither driven nor weighed one by one.
-  if (s.text("sample.kind") == "clumps") {
-    protocol::fail(s, "sample.kind", "must be spheres or grains on the ultrasonic bench");
-  }
-  const std::string& mode = s.text("loading.mode");
-  if (mode == "hydrostatic") {
-    requireAscending(s, "loading.stages_MPa", 0.0, 1e5, "MPa");
-  } else {
-    requireAscending(s, "loading.stages_axial_strain", 0.0, 0.5, "(-)");
-  }
-  requireAscending(s, "wave.receivers_at", s.real("wave.source_at"), 1.0,
-                   "(fractions of the sample, beyond wave.source_at)");
-  if (s.list("wave.receivers_at").size() < 2) {
-    protocol::fail(s, "wave.receivers_at", "needs at least two receivers for a velocity");
+  const bool hydrostatic = mode == LoadingMode::Hydrostatic;
+  const std::vector<double>& stages = hydrostatic ? stages_stress : stages_axial_strain;
+  const std::string key = hydrostatic ? "loading.stages_MPa" : "loading.stages_axial_strain";
+  if (stages.empty()) throw InvalidParameter("", key, "needs at least one value");
+  for (std::size_t i = 1; i < stages.size(); ++i) {
+    if (!(stages[i] > stages[i - 1])) throw InvalidParameter("", key, "must be ascending");
   }
 }
 
@@ -148,45 +54,43 @@ double bulkDensity(const Specimen<D>& sp) {
 template <int D>
 WaveSpec waveSpec(const Specimen<D>& sp, const Settings& s, const WaveKind& k) {
   const auto& walls = sp.sim->walls();
-  WaveSpec w;
+  WaveSpec w = s.wave;
   w.name = k.name;
   w.propagation = k.propagation;
   w.polarisation = k.polarisation;
-  w.frequency = s.si("wave.frequency_kHz");
-  w.amplitude = s.real("wave.amplitude_m_per_s");
   // Wall 2a bounds axis a from below, 2a + 1 from above (LoadingFrame).
   w.path_lo = walls[2 * k.propagation].point[k.propagation];
   w.path_hi = walls[2 * k.propagation + 1].point[k.propagation];
-  w.source_at = s.real("wave.source_at");
-  w.receivers_at = s.list("wave.receivers_at");
-  w.slab = s.real("wave.slab_diameters") * 2.0 * sp.mean_radius;
+  w.slab = s.slab_diameters * 2.0 * sp.mean_radius;
   double half_width = INFINITY;
   w.centre.assign(D, 0.0);
   for (int a = 0; a < D; ++a) {
     w.centre[a] = 0.5 * (walls[2 * a].point[a] + walls[2 * a + 1].point[a]);
     if (a != k.propagation) half_width = std::min(half_width, 0.5 * sp.frame->length(a));
   }
-  w.receiver_half_width = s.real("wave.receiver_half_width") * half_width;
-  w.first_break_fraction = s.real("wave.first_break_fraction");
-  w.max_steps = static_cast<std::uint64_t>(s.integer("wave.max_window_steps"));
-  w.sample_every = static_cast<int>(s.integer("wave.sample_every_steps"));
+  w.receiver_half_width = s.receiver_half_width * half_width;
   return w;
 }
 
 WaveRecord toRecord(const WaveResult& w, const WaveKind& k, const std::string& stage,
                     std::uint64_t step, double time) {
+  auto known = [](bool found, double v) { return found ? std::optional<double>(v) : std::nullopt; };
   WaveRecord r;
   r.step = step, r.time = time, r.stage = stage, r.name = k.name, r.type = k.type;
   r.propagation_axis = k.propagation, r.polarisation_axis = k.polarisation;
   r.frequency = w.spec.frequency, r.amplitude = w.spec.amplitude, r.dt = w.dt;
-  r.velocity_xcorr = w.xcorr.value, r.velocity_first_break = w.first_break.value;
+  r.velocity_xcorr = known(w.xcorr.value > 0.0, w.xcorr.value);
+  r.velocity_first_break = known(w.first_break.value > 0.0, w.first_break.value);
   r.source = w.source;
   for (const ReceiverTrace& t : w.receivers) {
     WaveRecord::Receiver x;
-    x.distance = t.distance, x.particles = t.particles, x.picked_samples = t.picked_samples;
+    x.distance = t.distance;
+    x.particles = static_cast<std::int64_t>(t.particles);
+    x.picked_samples = static_cast<std::int64_t>(t.picked_samples);
     x.samples = t.velocity;
-    x.xcorr_found = t.xcorr.found, x.xcorr_time = t.xcorr.time, x.xcorr_quality = t.xcorr.quality;
-    x.first_break_found = t.first_break.found, x.first_break_time = t.first_break.time;
+    x.xcorr_time = known(t.xcorr.found, t.xcorr.time);
+    x.xcorr_quality = known(t.xcorr.found, t.xcorr.quality);
+    x.first_break_time = known(t.first_break.found, t.first_break.time);
     r.receivers.push_back(std::move(x));
   }
   return r;
@@ -198,7 +102,7 @@ template <int D>
 void hold(Specimen<D>& sp, const Settings& s, std::uint64_t max_steps) {
   using Axis = typename LoadingFrame<D>::Axis;
   for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{});
-  const double ub = s.real("formation.unbalanced_force_ratio");
+  const double ub = s.specimen.formation.unbalanced_force_ratio;
   for (std::uint64_t n = 1; n <= max_steps; ++n) {
     sp.frame->step();
     if (n % 100 == 0 && sp.sim->unbalancedForceRatio() < ub) return;
@@ -210,13 +114,13 @@ template <int D>
 void strainBy(Specimen<D>& sp, const Settings& s, int axis, double strain) {
   using Axis = typename LoadingFrame<D>::Axis;
   using Mode = typename LoadingFrame<D>::Mode;
-  const double rate = s.real("static.strain_rate_per_s");
+  const double rate = s.static_strain_rate;
   const double target = sp.frame->strain(axis) + strain;
   sp.frame->set(axis, Axis{Mode::StrainRate, strain > 0.0 ? rate : -rate});
   while (strain > 0.0 ? sp.frame->strain(axis) < target : sp.frame->strain(axis) > target) {
     sp.frame->step();
   }
-  hold(sp, s, static_cast<std::uint64_t>(s.integer("wave.hold_steps")));
+  hold(sp, s, static_cast<std::uint64_t>(s.hold_steps));
 }
 
 struct StaticModulus {
@@ -262,7 +166,7 @@ std::vector<Vec<D>> positionsBySlot(const Simulation<D>& sim) {
 template <int D>
 StaticModulus staticModulus(const Specimen<D>& sp, const Settings& s, int axis) {
   Specimen<D> copy = sp.branch();
-  const double amplitude = s.real("static.strain_amplitude");
+  const double amplitude = s.static_strain_amplitude;
   const auto a = positionsBySlot(*copy.sim);
   const double sa = copy.frame->stress(axis);
   strainBy(copy, s, axis, amplitude);
@@ -309,12 +213,12 @@ StageResult measureStage(Specimen<D>& sp, const Settings& s, const std::string& 
   // the window would drown the pulse, and would not repeat in the background copy.
   control.tick(stage, step, -1.0, "holding a copy at rest");
   Specimen<D> rest = sp.branch();
-  hold(rest, s, static_cast<std::uint64_t>(s.integer("wave.hold_steps")));
+  hold(rest, s, static_cast<std::uint64_t>(s.hold_steps));
   for (const WaveKind& k : figure18Waves<D>()) {
     control.tick(stage, step, -1.0, std::string("wave ") + k.name);
     Specimen<D> copy = rest.branch();
     WaveSpec spec = waveSpec(copy, s, k);
-    spec.frames = frames ? static_cast<int>(s.integer("wave.frames")) : 0;
+    spec.frames = frames ? s.frames : 0;
     const auto t0 = std::chrono::steady_clock::now();
     const WaveResult w = measureWave(*copy.sim, spec);
     out.wave_seconds += secondsSince(t0);
@@ -352,7 +256,7 @@ StageResult measureStage(Specimen<D>& sp, const Settings& s, const std::string& 
   dynamic("vp_x", "modulus_x");
   dynamic("vs_zx", "shear_modulus_zx");
   dynamic("vs_xy", "shear_modulus_xy");
-  if (s.flag("static.enabled")) {
+  if (s.static_moduli) {
     constexpr int z = D - 1;
     for (const auto& [axis, name] : {std::pair{z, "modulus_z"}, std::pair{0, "modulus_x"}}) {
       control.tick(stage, step, -1.0, std::string("static cycle ") + name);
@@ -372,12 +276,12 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   using Axis = typename LoadingFrame<D>::Axis;
   using Mode = typename LoadingFrame<D>::Mode;
   constexpr int ax = Specimen<D>::kAxial;
-  Specimen<D> sp = buildSpecimen<D>(s, control);
+  Specimen<D> sp = buildSpecimen<D>(s.specimen, control);
   rec.result("particles", static_cast<double>(sp.sim->particles().size()), "");
-  formAndCement(sp, s, rec, control);
+  formAndCement(sp, rec, control);
+  const auto record_every = static_cast<std::uint64_t>(s.specimen.output.record_every_steps);
   auto& frame = *sp.frame;
-  const std::string& mode = s.text("loading.mode");
-  const double stress_rate = s.si("loading.stress_rate_MPa_per_s");
+  const double stress_rate = s.stress_rate;
   std::vector<StageResult> stages;
   std::size_t count = 0;
   auto measure = [&](bool last) {
@@ -386,27 +290,27 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   };
   sp.resetBrokenCount();
   frame.resetReference();
-  if (mode == "hydrostatic") {
-    const std::vector<double> p = s.listSi("loading.stages_MPa");
+  if (s.mode == LoadingMode::Hydrostatic) {
+    const std::vector<double>& p = s.stages_stress;
     for (std::size_t k = 0; k < p.size(); ++k) {
-      servoTo(sp, s, p[k], p[k], stress_rate, "loading", rec, control);
+      servoTo(sp, p[k], p[k], stress_rate, "loading", rec, control);
       measure(k + 1 == p.size());
     }
   } else {
-    if (mode == "triaxial") {
-      const double sigma3 = s.si("loading.confining_stress_MPa");
-      servoTo(sp, s, sigma3, sigma3, stress_rate, "confinement", rec, control);
+    if (s.mode == LoadingMode::Triaxial) {
+      const double sigma3 = s.confining_stress;
+      servoTo(sp, sigma3, sigma3, stress_rate, "confinement", rec, control);
       frame.resetReference();
     } else {
       for (int a = 0; a < D; ++a) frame.set(a, Axis{});
     }
-    const double rate = s.real("loading.axial_strain_rate_per_s");
+    const double rate = s.axial_strain_rate;
     frame.set(ax, Axis{Mode::StrainRate, rate});
-    const std::vector<double> at = s.list("loading.stages_axial_strain");
+    const std::vector<double>& at = s.stages_axial_strain;
     std::size_t next = 0;
     while (next < at.size()) {
       frame.step();
-      if (sp.sim->steps() % sp.record_every == 0) recordState(sp, rec, "loading.", "loading", rate);
+      if (sp.sim->steps() % record_every == 0) recordState(sp, rec, "loading.", "loading", rate);
       if (sp.sim->steps() % 200 == 0) {
         control.tick("loading", sp.sim->steps(), frame.strain(ax) / at.back(),
                      "axial stress " + fmt(frame.stress(ax) / 1e6) + " MPa");
@@ -417,7 +321,7 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
       }
     }
   }
-  snapshot(sp, s, rec, "loading", "final");
+  snapshot(sp, rec, "loading", "final");
   for (const auto& [name, value] : stages.back().values) rec.result(name, value, "");
   double min_wavelength = INFINITY, disagreement = 0.0;
   StageResult cost;
@@ -446,7 +350,8 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
 }  // namespace
 
 void run(const Settings& s, Recorder& rec, RunControl& control) {
-  byDimension(s, [&](auto dim) { runDimension<dim.value>(s, rec, control); });
+  byDimension(s.specimen.protocol.dimension,
+              [&](auto dim) { runDimension<dim.value>(s, rec, control); });
 }
 
 }  // namespace rocklab::rigs::ultrasonic

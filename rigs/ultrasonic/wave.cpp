@@ -8,6 +8,18 @@
 
 namespace rocklab::rigs::ultrasonic {
 
+void WaveSpec::validate() const {
+  if (receivers_at.size() < 2) {
+    throw InvalidParameter("", "receivers_at", "needs at least two receivers for a velocity");
+  }
+  for (std::size_t i = 0; i < receivers_at.size(); ++i) {
+    if (!(receivers_at[i] > (i == 0 ? source_at : receivers_at[i - 1]))) {
+      throw InvalidParameter("", "receivers_at",
+                             "must be ascending, beyond wave.source_at (fractions of the sample)");
+    }
+  }
+}
+
 namespace {
 
 void check(const WaveSpec& s, int dimension) {

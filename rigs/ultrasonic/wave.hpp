@@ -23,7 +23,7 @@ struct WaveSpec {
   int propagation = 0;                  // axis the wave travels along
   int polarisation = 0;                 // axis of the particle motion: the propagation axis for P
   double frequency = 0.0;               // Hz, of the one-period sine pulse
-  double amplitude = 0.0;               // m/s, the source's peak velocity
+  double amplitude = 1e-3;              // m/s, the source's peak velocity
   double path_lo = 0.0, path_hi = 0.0;  // m, the sample's extent along the path
   double source_at = 0.1;               // source slab centre, fraction of the path from path_lo
   std::vector<double> receivers_at{0.35, 0.5, 0.65, 0.8};  // receiver slab centres, likewise
@@ -55,6 +55,34 @@ struct WaveSpec {
   // cheaper to store and pick, and coarser in time. At least four samples per pulse period.
   int sample_every = 1;
   int frames = 0;  // wave-front frames: one every pulse period from the pulse's end
+
+  // The keys a protocol sets (its `wave.*` section; the geometry is the bench's).
+  template <class F>
+  void fields(F& f) {
+    f(frequency, {"frequency_kHz", units::kHz, Range::leftOpen(0, 1e9),
+                  "frequency of the one-period sine velocity pulse; its wavelength should span "
+                  "several grains (checked)",
+                  true});
+    f(amplitude, {"amplitude_m_per_s", units::m_per_s, Range::leftOpen(0, 1e3),
+                  "peak velocity of the source: small, so that contacts stay in their elastic "
+                  "range"});
+    f(source_at, {"source_at", units::none, Range::leftOpen(0, 1),
+                  "source slab centre along the path, as a fraction of the sample from its low "
+                  "face"});
+    f(receivers_at, {"receivers_at", units::none, Range::leftOpen(0, 1),
+                     "receiver slab centres along the path, fractions of the sample, ascending"});
+    f(first_break_fraction, {"first_break_fraction", units::none, Range::open(0, 1),
+                             "first-break level, as a fraction of each trace's peak magnitude"});
+    f(sample_every, {"sample_every_steps", units::none, Range::closed(1, 1e6),
+                     "the receivers' sampling: one sample every this many steps (1: every step; "
+                     "at least four samples per pulse period, checked)"});
+    f(max_steps, {"max_window_steps", units::none, Range::closed(100, 1e9),
+                  "longest recording of one wave; it stops earlier once the farthest receiver "
+                  "has heard the pulse"});
+  }
+  // At least two receivers, ascending beyond the source (their spacing against the slab
+  // thickness is checked on the sample, by measureWave).
+  void validate() const;
 };
 
 struct ReceiverTrace {

@@ -188,7 +188,7 @@ TEST(Cli, BadInputIsRefusedClearly) {
   r = run("pack --dist normal --d-mean-mm 9 --d-min-mm 1 --d-max-mm 2 --out /tmp/x.txt");
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.out.find("d_mean"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("(m)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(mm)"), std::string::npos) << r.out;
   r = run("frobnicate");
   EXPECT_NE(r.status, 0);
 }

@@ -111,7 +111,7 @@ Simulation<3> densePack(double dt_factor) {
   spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
   spec.porosity = 0.37;  // beyond jamming: every particle is loaded
   const Packing<3> p = generatePacking<3>(spec);
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.contact_law = "hertz";
   Simulation<3> sim(testing::table(testing::hertzMaterial(1e9, 0.25, 0.5)), cfg);
   for (std::size_t i = 0; i < p.centers.size(); ++i) {
@@ -207,6 +207,7 @@ TEST(HardCases, BrittleSampleAtHighStressBreaksInACascade) {
   testing::addBox<3>(sim, p.lo, p.hi);
   BondKind brittle;
   brittle.modulus = 1e9;
+  brittle.stiffness_ratio = 1.0;
   brittle.tensile_mean = brittle.shear_mean = 2e6;
   brittle.tensile_std = brittle.shear_std = 0.05e6;
   const CementReport cement = sim.cement(sim.addBondKind(brittle), 0.0);
@@ -234,11 +235,11 @@ TEST(HardCases, BrittleSampleAtHighStressBreaksInACascade) {
 }
 
 TEST(HardCases, OneParticleAndEmptyScenes) {
-  Simulation<3> one(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), SimulationConfig{});
+  Simulation<3> one(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), testing::undamped());
   testing::addParticle<3>(one, V3::Zero(), 1e-3, V3(0.1, 0, 0));
   ASSERT_NO_THROW(one.run(100));
   EXPECT_NEAR(one.particles().pos[0].x(), 0.1 * one.time(), 1e-12);
-  Simulation<3> none(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), SimulationConfig{});
+  Simulation<3> none(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), testing::undamped());
   EXPECT_THROW(none.step(), std::invalid_argument);
 }
 

@@ -79,6 +79,7 @@ Simulation<3> scene() {
   testing::addBox<3>(sim, p.lo, p.hi);
   BondKind cement;
   cement.modulus = 1e8;
+  cement.stiffness_ratio = 1.0;
   cement.tensile_mean = cement.shear_mean = 2e4;
   cement.tensile_std = cement.shear_std = 2e4;
   sim.cement(sim.addBondKind(cement), 0.2);
@@ -110,7 +111,7 @@ TEST(Checkpoint, RestartContinuesBitForBit) {
   EXPECT_EQ(a.time(), b.time());
   EXPECT_EQ(a.energy().ledger.viscous, b.energy().ledger.viscous);
   EXPECT_EQ(a.bonds().size(), b.bonds().size());
-  EXPECT_EQ(a.takeBondBreaks().size(), b.takeBondBreaks().size());
+  EXPECT_EQ(a.bondBreaks().size(), b.bondBreaks().size());
   std::filesystem::remove(path);
 }
 

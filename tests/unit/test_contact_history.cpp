@@ -18,7 +18,7 @@ struct Driven {
 
 // Two driven (fixed) spheres in contact, and a far anchor that pins the sort grid.
 Driven makePair(double skin, bool spatial_sort) {
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.skin = skin;
   cfg.spatial_sort = spatial_sort;
   cfg.timestep.automatic = false;

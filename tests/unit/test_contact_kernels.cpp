@@ -62,6 +62,7 @@ TEST(ContactLaws, MixingRules) {
   Material a, b;
   a.kn = 2e6, a.ks = 1e6, a.friction = 0.6, a.damping_ratio = 0.1;
   b.kn = 2e6, b.ks = 0.0, b.friction = 0.2, b.damping_ratio = 0.3;
+  a.modulus = b.modulus = 0.0;  // the particle springs alone
   m.add(a);
   m.add(b);
   auto lin = makeContactModel<3>("linear", m);

@@ -82,7 +82,7 @@ TEST(SizeDistribution, ImpossibleSettingsNameTheKey) {
     SizeDistribution::normal(5e-3, 1e-4, 1e-3, 2e-3).validate();
     FAIL();
   } catch (const InvalidParameter& e) {
-    EXPECT_EQ(e.key(), "d_mean");
+    EXPECT_EQ(e.key(), "d_mean_mm");  // its protocol key
   }
   EXPECT_THROW(SizeDistribution::uniform(2e-3, 1e-3).validate(), InvalidParameter);
   EXPECT_THROW(SizeDistribution::phiGaussian(5.0, 0.1, 1e-3, 2e-3).validate(), InvalidParameter);

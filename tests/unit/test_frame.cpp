@@ -21,7 +21,7 @@ struct Lattice {
   explicit Lattice(int n_, double wall_overlap) : n(n_) {
     MaterialTable m;
     m.add(testing::linearMaterial(kKn, kKn, 0.0));
-    SimulationConfig cfg;
+    SimulationConfig cfg = testing::undamped();
     cfg.timestep.automatic = false;
     cfg.timestep.fixed_dt = 1e-6;
     sim = std::make_unique<Simulation<3>>(m, cfg);

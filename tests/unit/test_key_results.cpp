@@ -1,7 +1,6 @@
-// Key results: each definition evaluated on run data built by hand, where the right value is
-// known exactly; a protocol naming an undefined key result is refused with its file and line;
-// the accuracy study's error, Pareto front and cheapest setting on notebook runs of known
-// values and times.
+// Key results: each rule evaluated on run data built by hand, where the right value is known
+// exactly; the rules held to the rigs' declarations; the accuracy study's error, Pareto front
+// and cheapest setting on notebook runs of known values and times.
 
 #include <gtest/gtest.h>
 
@@ -15,6 +14,7 @@
 #include "lab/notebook/notebook.hpp"
 #include "reports/key_results.hpp"
 #include "reports/study.hpp"
+#include "rigs/common/outputs.hpp"
 
 namespace rocklab::reports {
 namespace {
@@ -94,24 +94,38 @@ TEST(KeyResults, PrefixesPickATestACopyOrAStage) {
   EXPECT_NEAR(*evaluateKeyResult(perm, "k_over_k0_at_half_peak_stress"), 0.8, 1e-12);
 }
 
-TEST(KeyResults, AProtocolNamingAnUndefinedResultIsRefused) {
-  protocol::Schema sc;
-  sc.text("protocol.name", std::nullopt, "");
-  sc.textList("protocol.key_results", std::vector<std::string>{}, "");
-  const auto s = protocol::parseProtocol(
-      "p.toml", "[protocol]\nname = \"t\"\nkey_results = [\"ucs_MPa\", \"ucs_GPa\"]\n", sc);
-  EXPECT_NO_THROW(checkKeyResults(
-      "biaxial", protocol::parseProtocol("q.toml", "[protocol]\nname = \"t\"\n", sc)));
-  try {
-    checkKeyResults("biaxial", s);
-    FAIL() << "no error";
-  } catch (const protocol::ProtocolError& e) {
-    const std::string m = e.what();
-    EXPECT_NE(m.find("p.toml:3: protocol.key_results: 'ucs_GPa' is not a key result of the "
-                     "biaxial rig: one of peak_deviatoric_stress_MPa, ucs_MPa"),
-              std::string::npos)
-        << m;
-    EXPECT_EQ(m.find("'ucs_MPa'"), std::string::npos) << m;
+// Every key result a rig declares has its rule here and every rule a declaration, and what
+// a rule reads is something the rig records: a definition cannot ask for a series no rig
+// writes.
+// A declared name with each '#' a number: what a protocol would name.
+std::string instance(std::string_view pattern) {
+  std::string s(pattern);
+  for (std::size_t k = s.find('#'); k != std::string::npos; k = s.find('#')) s.replace(k, 1, "2");
+  return s;
+}
+
+TEST(KeyResults, RulesMatchTheRigsDeclarations) {
+  for (const char* rig :
+       {"oedometer", "biaxial", "envelope", "hydrostatic", "permeameter", "ultrasonic"}) {
+    const rigs::Outputs* outputs = rigs::rigOutputs(rig);
+    ASSERT_NE(outputs, nullptr) << rig;
+    for (const rigs::OutputDecl& d : outputs->keyResults()) {
+      EXPECT_NE(findKeyResultRule(rig, instance(d.name)), nullptr)
+          << rig << " declares " << d.name << " but reports has no rule for it";
+    }
+    for (const KeyResultRule& rule : keyResultRules(rig)) {
+      EXPECT_NE(outputs->keyResult(instance(rule.name)), nullptr)
+          << rig << ": the rule " << rule.name << " is no key result the rig declares";
+      const bool from_series = !rule.x_series.empty();
+      const auto kind = from_series ? rigs::OutputKind::Series : rigs::OutputKind::Result;
+      const std::string source = instance(rule.source.empty() ? rule.name : rule.source);
+      EXPECT_TRUE(outputs->declares(kind, source))
+          << rig << ": the rule " << rule.name << " reads " << source << ", which is not recorded";
+      if (from_series) {
+        EXPECT_TRUE(outputs->declares(rigs::OutputKind::Series, rule.x_series))
+            << rig << ": the rule " << rule.name << " reads " << rule.x_series;
+      }
+    }
   }
 }
 

@@ -189,7 +189,9 @@ TEST(BondOrientations, CountsBondsNearTheAxisAndNearItsNormalPlane) {
   }
   BondKind cement;
   cement.modulus = 1e9;
+  cement.stiffness_ratio = 1.0;
   cement.tensile_mean = cement.shear_mean = 1e6;
+  cement.tensile_std = cement.shear_std = 0.0;
   const std::uint8_t kind = sim.addBondKind(cement);
   ASSERT_EQ(sim.cement(kind, 0.01).installed, 5u);
   const BondOrientations n = bondOrientations(sim, kind, 2);

@@ -63,7 +63,7 @@ TEST_F(NotebookTest, RecordsARunAndClosesIt) {
     id = w.id();
     EXPECT_EQ(scalar(nb, "SELECT status FROM runs WHERE id = " + std::to_string(id)), "running");
     for (int k = 0; k < 10; ++k) w.series("axial_stress_MPa", k * 100, k * 1e-3, 2.0 * k);
-    EventRow e;
+    EventRecord e;
     e.kind = "bond_break";
     e.mode = "tensile";
     e.x = 1e-3;
@@ -109,14 +109,14 @@ TEST_F(NotebookTest, SnapshotFilesLiveBesideTheNotebookAndAreRecorded) {
 TEST_F(NotebookTest, WavesKeepTheirTracesAndPicksSampleForSample) {
   Notebook nb(path_);
   RunWriter w(nb, info(), {});
-  WaveRow row;
+  WaveRecord row;
   row.step = 77, row.time = 1e-3, row.stage = "stage 2", row.name = "szx", row.type = "S";
   row.propagation_axis = 2, row.polarisation_axis = 0;
   row.frequency = 2e5, row.amplitude = 1e-3, row.dt = 1e-8;
   row.velocity_xcorr = 812.5;  // no first-break velocity: stored as NULL
   row.source = {0.0, 0.5, -0.25, 1.0 / 3.0};
   for (int r = 0; r < 3; ++r) {
-    WaveRow::Receiver x;
+    WaveRecord::Receiver x;
     x.distance = 1e-3 * (r + 1), x.particles = 10 + r, x.picked_samples = 2 + r;
     x.samples = {0.1 * r, -1e-300, 3.0e10, 0.0, 7.0};
     if (r != 1) x.xcorr_time = 1e-6 * r, x.xcorr_quality = 0.9;
@@ -128,9 +128,9 @@ TEST_F(NotebookTest, WavesKeepTheirTracesAndPicksSampleForSample) {
   EXPECT_EQ(id, 1);
   EXPECT_EQ(scalar(nb, "SELECT count(*) FROM picks"), "5");
   EXPECT_EQ(scalar(nb, "SELECT samples FROM traces LIMIT 1"), "<40 bytes>");
-  const std::vector<WaveRow> back = wavesOf(nb, 1);
+  const std::vector<WaveRecord> back = wavesOf(nb, 1);
   ASSERT_EQ(back.size(), 1u);
-  const WaveRow& b = back[0];
+  const WaveRecord& b = back[0];
   EXPECT_EQ(b.step, 77u);
   EXPECT_EQ(b.stage + b.name + b.type, "stage 2szxS");
   EXPECT_EQ(b.propagation_axis, 2);

@@ -2,24 +2,50 @@
 
 #include <gtest/gtest.h>
 
-#include "lab/protocol/params.hpp"
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+#include "lab/protocol/declare.hpp"
 
 namespace rocklab::protocol {
 namespace {
 
+enum class Negative { Skip, Resample };
+
+// A settings struct as the rigs write them (lab/core/fields.hpp): keys in several sections.
+struct Sample {
+  std::string name, rig;
+  double axial_stress = 0.0;  // Pa, required
+  double local_damping = 0.7;
+  std::int64_t count = 2000;
+  Negative negative = Negative::Skip;
+  bool quiet = false;
+  std::vector<double> cycles;
+  std::vector<std::string> key_results;
+
+  template <class F>
+  void fields(F& f) {
+    static constexpr Choice<Negative> kNegative[] = {{"skip", Negative::Skip},
+                                                     {"resample", Negative::Resample}};
+    auto p = f.at("protocol.");
+    p(name, {"name", units::text, {}, "protocol name", true});
+    p(rig, {"rig", units::text, {}, "rig", true});
+    f.at("formation.")(axial_stress, {"axial_stress_MPa", units::MPa, Range::leftOpen(0, 500),
+                                      "axial stress", true});
+    f.at("numerics.")(local_damping,
+                      {"local_damping", units::none, Range::rightOpen(0, 1), "PFC local damping"});
+    f.at("sample.")(count, {"count", units::none, Range::closed(2, 1e8), "particles"});
+    f.at("bonds.")(negative, {"negative_strength", units::text, {}, "draws <= 0"}, kNegative);
+    f.at("output.")(quiet, {"quiet", units::text, {}, "no progress"});
+    f.at("loading.")(cycles, {"cycle_at_axial_strain", units::none, Range::open(0, 1), "cycles"});
+    p(key_results, {"key_results", units::text, {}, "key results"});
+  }
+};
+
 Schema schema() {
   Schema s;
-  s.text("protocol.name", std::nullopt, "protocol name");
-  s.text("protocol.rig", std::nullopt, "rig");
-  range(s.real("formation.axial_stress_MPa", "MPa", 1e6, std::nullopt, "axial stress"), 0, true,
-        500, false);
-  range(s.real("numerics.local_damping", "-", 1, 0.7, "PFC local damping"), 0, false, 1, true);
-  range(s.integer("sample.count", 2000, "particles"), 2, false, 1e8, false);
-  s.choice("bonds.negative_strength", {"skip", "resample"}, "skip", "draws <= 0");
-  s.flag("output.quiet", false, "no progress");
-  range(s.realList("loading.cycle_at_axial_strain", "-", 1, std::vector<double>{}, "cycles"), 0,
-        true, 1, true);
-  s.textList("protocol.key_results", std::vector<std::string>{}, "key results");
+  declare<Sample>(s);
   return s;
 }
 
@@ -39,7 +65,7 @@ TEST(Protocol, ParsesValuesDefaultsAndUnits) {
   const Schema sc = schema();
   const Settings s = parseProtocol("p.toml", kGood, sc);
   EXPECT_DOUBLE_EQ(s.real("formation.axial_stress_MPa"), 30.0);
-  EXPECT_DOUBLE_EQ(s.si("formation.axial_stress_MPa"), 30e6);
+  EXPECT_DOUBLE_EQ(read<Sample>(s).axial_stress, 30e6);
   EXPECT_DOUBLE_EQ(s.real("numerics.local_damping"), 0.7);  // default
   EXPECT_EQ(s.integer("sample.count"), 2000);
   EXPECT_EQ(s.text("bonds.negative_strength"), "skip");
@@ -130,7 +156,7 @@ axial_stress_MPa = 30
   EXPECT_EQ(t.texts("protocol.key_results"),
             (std::vector<std::string>{"ucs_MPa", "test2.band_angle_deg"}));
   bool shown = false;
-  for (const ParamRow& r : t.table()) {
+  for (const notebook::ParamRow& r : t.table()) {
     if (r.key == "protocol.key_results") {
       EXPECT_EQ(r.value, "[\"ucs_MPa\", \"test2.band_angle_deg\"]");
       shown = true;
@@ -180,6 +206,97 @@ TEST(Protocol, CommandLineValuesAreReadAsTheKeysKindAndChecked) {
             std::string::npos);
   EXPECT_NE(error("numerics.damping", "0.1").find("not a key"), std::string::npos);
   EXPECT_DOUBLE_EQ(s.real("numerics.local_damping"), 0.35);  // a refused value changes nothing
+}
+
+// A section of two fields and a rule across them, as a rig's loading.
+struct Ramp {
+  double from = 1.0 * kMPa, to = 2.5 * kMPa;  // Pa
+  double angle = 0.0;                         // rad
+  double grain = 0.6 * kmm;                   // m
+
+  template <class F>
+  void fields(F& f) {
+    f(from, {"from_MPa", units::MPa, Range::closed(0, 100), "start"});
+    f(to, {"to_MPa", units::MPa, Range::closed(0, 100), "end"});
+    f(angle, {"angle_deg", units::deg, Range::closed(0, 85), "an angle"});
+    f(grain, {"grain_mm", units::mm, Range::leftOpen(0, 10), "a size"});
+  }
+  void validate() const {
+    if (to <= from) throw InvalidParameter("", "to_MPa", "must exceed from_MPa");
+  }
+};
+
+struct TwoRamps {
+  Ramp up;
+  Ramp down{3.0 * kMPa, 4.0 * kMPa};  // a second use of the declaration, its own defaults
+  template <class F>
+  void fields(F& f) {
+    f.section("up.", up);
+    f.section("down.", down);
+  }
+};
+
+bool sameBits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+TEST(Declarations, StructsAreReadInSiWithTheLibrarysDefaultsBitForBit) {
+  Schema sc;
+  declare<TwoRamps>(sc);
+  EXPECT_EQ(sc.find("down.from_MPa")->unit.name, "MPa");
+  EXPECT_EQ(std::get<double>(*sc.find("down.from_MPa")->fallback), 3.0);  // its own default
+  EXPECT_EQ(std::get<double>(*sc.find("up.grain_mm")->fallback), 0.6);
+  const Settings s = parseProtocol("p.toml", "[up]\nto_MPa = 7.5\nangle_deg = 30\n", sc);
+  const TwoRamps r = read<TwoRamps>(s);
+  EXPECT_TRUE(sameBits(r.up.to, 7.5 * kMPa));
+  EXPECT_TRUE(sameBits(r.up.angle, 30.0 * std::numbers::pi / 180.0));  // degrees to radians
+  const TwoRamps defaults;
+  EXPECT_TRUE(sameBits(r.up.from, defaults.up.from));
+  EXPECT_TRUE(sameBits(r.up.grain, defaults.up.grain));
+  EXPECT_TRUE(sameBits(r.down.from, defaults.down.from));
+  EXPECT_TRUE(sameBits(r.down.to, defaults.down.to));
+}
+
+TEST(Declarations, ADefaultItsUnitCannotCarryBackExactlyIsRefused) {
+  // Dividing by 1e6 and multiplying back is not the identity for every double: find one.
+  double v = 0.123456789;
+  while (sameBits(units::MPa.toSi(units::MPa.fromSi(v)), v)) v = std::nextafter(v, 1.0);
+  Ramp odd;
+  odd.from = v;
+  Schema sc;
+  EXPECT_THROW(declare(sc, odd), std::logic_error);
+}
+
+TEST(Declarations, RulesAcrossFieldsNameTheFileLineAndKey) {
+  Schema sc;
+  declare<TwoRamps>(sc);
+  const Settings s = parseProtocol("p.toml", "[down]\nfrom_MPa = 5\nto_MPa = 4\n", sc);
+  try {
+    read<TwoRamps>(s);
+    FAIL() << "no error";
+  } catch (const ProtocolError& e) {
+    EXPECT_STREQ(e.what(), "p.toml:3: down.to_MPa: must exceed from_MPa");
+  }
+  // The core checks the same declaration, naming the key with its section and unit.
+  TwoRamps bad;
+  bad.up.angle = 1.6;  // rad: above 85 degrees
+  try {
+    checkFields(bad, "ramps");
+    FAIL() << "no error";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.key(), "up.angle_deg");
+    EXPECT_EQ(e.unit(), "deg");
+    EXPECT_NE(std::string(e.what()).find("ramps: up.angle_deg = 91.6"), std::string::npos)
+        << e.what();
+  }
+  bad = TwoRamps{};
+  bad.down.to = bad.down.from;
+  try {
+    checkFields(bad, "ramps");
+    FAIL() << "no error";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.key(), "down.to_MPa");
+  }
 }
 
 }  // namespace

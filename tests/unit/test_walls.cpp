@@ -20,7 +20,7 @@ Wall<3> plane(const V3& normal, const V3& point, const std::string& name) {
 
 TEST(Walls, ForceReadOutIsTheContactForce) {
   const double kn = 2e6, r = 1e-3, overlap = 3e-6;
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.timestep.automatic = false;
   cfg.timestep.fixed_dt = 1e-6;
   Simulation<3> sim(testing::table(testing::linearMaterial(kn, kn, 0.5)), cfg);
@@ -97,7 +97,7 @@ TEST(Walls, ServoFollowsARamp) {
 }
 
 TEST(Walls, ServoSettingsAreValidated) {
-  Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), SimulationConfig{});
+  Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), testing::undamped());
   addParticle<3>(sim, V3(0, 0, 1e-3), 1e-3, V3::Zero());
   auto lid = plane(-V3::UnitZ(), V3(0, 0, 2e-3), "lid");
   lid.servo.enabled = true;

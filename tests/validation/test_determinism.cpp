@@ -82,6 +82,7 @@ TEST(Determinism, BondBreaksAreTheSameOnOneAndTwoThreadsAndInLanes) {
     testing::addBox<3>(sim, p.lo, p.hi);
     BondKind cement;
     cement.modulus = 1e8;
+    cement.stiffness_ratio = 1.0;
     cement.tensile_mean = cement.shear_mean = 1e5;
     cement.tensile_std = cement.shear_std = 1e5;
     sim.cement(sim.addBondKind(cement), 0.05);

@@ -39,7 +39,7 @@ void checkConservation(const std::string& law, const Material& m, std::uint64_t 
   spec.porosity = D == 3 ? 0.7 : 0.5;
   spec.seed = seed;
   const Packing<D> p = generatePacking<D>(spec);
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.contact_law = law;
   cfg.timestep.safety = 0.025;
   Simulation<D> sim(testing::table(m), cfg);
@@ -123,6 +123,7 @@ TEST(Energy, LedgerClosesWithBondBreaks) {
   testing::addBox<3>(sim, p.lo, p.hi);
   BondKind cement;
   cement.modulus = 1e8;
+  cement.stiffness_ratio = 1.0;
   cement.tensile_mean = cement.shear_mean = 2e5;
   cement.tensile_std = cement.shear_std = 1e5;
   sim.cement(sim.addBondKind(cement), 0.05);
@@ -143,7 +144,7 @@ TEST(Energy, LedgerClosesWithBondBreaks) {
 }
 
 TEST(Energy, GravityWorkIsBooked) {
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.gravity = {0.0, 0.0, -9.81};
   cfg.timestep.safety = 0.1;
   Simulation<3> sim(testing::table(testing::linearMaterial(1e5, 5e4, 0.3, 0.3)), cfg);

@@ -21,7 +21,7 @@ using testing::table;
 // `scale`, jittered: no contacts, so only the fluid acts.
 template <int D>
 Simulation<D> latticeScene(int n, int height, double scale, std::uint64_t seed) {
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.timestep.automatic = false;
   cfg.timestep.fixed_dt = 1e-6;
   Simulation<D> sim(table(linearMaterial(1e6, 1e6, 0.5)), cfg);
@@ -94,6 +94,7 @@ template <int D>
 void seepageForceBalancesTheDrop() {
   auto sim = latticeScene<D>(D == 2 ? 16 : 6, D == 2 ? 28 : 12, 1e-3, 4);
   FlowSettings fs;
+  fs.merge.small_pore_ratio = 0.0;  // every cell its own pore
   fs.pressures = {3.0e4, 1.0e4};
   FlowCoupling<D> flow(fs);
   const double A = crossSection(sim);
@@ -140,6 +141,7 @@ TEST(FlowCoupling, SeepageForceBalancesTheDropAndMovesTheParticles2D) {
 template <int D>
 void permeabilityScalesWithTheSquareOfTheGrainSize() {
   FlowSettings fs;
+  fs.merge.small_pore_ratio = 0.0;  // every cell its own pore
   fs.apply_forces = false;
   auto small = latticeScene<D>(5, 9, 1e-4, 7);
   auto large = latticeScene<D>(5, 9, 1e-3, 7);
@@ -161,6 +163,7 @@ TEST(FlowCoupling, PermeabilityScalesWithTheSquareOfTheGrainSize) {
 TEST(FlowCoupling, NetworkFollowsTheParticlesAndIsRebuiltOnlyWhenTheyMoveFar) {
   auto sim = latticeScene<3>(5, 8, 1e-3, 9);
   FlowSettings fs;
+  fs.merge.small_pore_ratio = 0.0;  // every cell its own pore
   fs.apply_forces = false;
   FlowCoupling<3> flow(fs);
   const FlowReading r0 = flow.measure(sim);

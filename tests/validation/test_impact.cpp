@@ -56,7 +56,7 @@ double hertzTimeFactor() {
 constexpr double kE = 70e9, kNu = 0.25, kRho = 2650, kR = 1e-3;
 
 Simulation<3> hertzScene(double dt, double damping_ratio = 0.0) {
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.contact_law = "hertz";
   cfg.timestep.automatic = false;
   cfg.timestep.fixed_dt = dt;
@@ -103,7 +103,7 @@ TEST(HertzImpact, SphereWallDurationAndOverlap) {
 }
 
 Simulation<3> linearScene(double kn, double beta, double dt) {
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.timestep.automatic = false;
   cfg.timestep.fixed_dt = dt;
   return Simulation<3>(testing::table(testing::linearMaterial(kn, 0.0, 0.0, beta, kRho)), cfg);

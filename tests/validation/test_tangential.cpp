@@ -19,7 +19,7 @@ constexpr double kE = 70e9, kNu = 0.25, kR = 1e-3;
 // F_t = mu F_n, after which it slides at mu F_n.
 TEST(Tangential, MindlinLoadingThenSliding) {
   const double overlap = 2e-6, mu = 0.3, v = 0.01, dt = 1e-7;
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.contact_law = "hertz";
   cfg.timestep.automatic = false;
   cfg.timestep.fixed_dt = dt;
@@ -68,7 +68,7 @@ TEST(Tangential, MindlinLoadingThenSliding) {
 // is how the stored force follows the turning contact frame.
 void rigidRotation(const V3& axis_in) {
   const double overlap = 2e-6, dt = 1e-7, kn = 1e7;
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.timestep.automatic = false;
   cfg.timestep.fixed_dt = dt;
   Simulation<3> sim(testing::table(testing::linearMaterial(kn, kn, 10.0)), cfg);
@@ -131,7 +131,7 @@ TEST(Tangential, ObjectiveUnderRigidRotationOblique) {
 
 TEST(Tangential, ObjectiveUnderRigidRotation2D) {
   const double overlap = 2e-6, dt = 1e-7, kn = 1e7;
-  SimulationConfig cfg;
+  SimulationConfig cfg = testing::undamped();
   cfg.timestep.automatic = false;
   cfg.timestep.fixed_dt = dt;
   Simulation<2> sim(testing::table(testing::linearMaterial(kn, kn, 10.0)), cfg);

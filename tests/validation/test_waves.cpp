@@ -34,7 +34,8 @@ BondKind stiffCement(double stiffness_ratio) {
   BondKind k;
   k.modulus = kModulus;
   k.stiffness_ratio = stiffness_ratio;
-  k.tensile_mean = k.shear_mean = 1e12;  // never breaks
+  k.tensile_mean = k.shear_mean = 1e11;  // never breaks
+  k.tensile_std = k.shear_std = 0.0;
   return k;
 }
 

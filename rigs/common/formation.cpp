@@ -1,0 +1,134 @@
+#include "rigs/common/formation.hpp"
+
+#include <sstream>
+
+#include "rigs/common/measurements.hpp"
+
+namespace rocklab::rigs {
+
+namespace {
+
+// Runs the frame until the stresses hold and the sample is in equilibrium; returns the
+// steps it took.
+template <int D>
+std::uint64_t settle(Specimen<D>& sp, const std::string& stage, Recorder& rec,
+                     RunControl& control) {
+  auto& sim = *sp.sim;
+  const FormationSettings& f = sp.settings.formation;
+  const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
+  const auto max_steps = static_cast<std::uint64_t>(f.max_steps);
+  const std::uint64_t start = sim.steps();
+  for (;;) {
+    sp.frame->step();
+    const std::uint64_t done = sim.steps() - start;
+    if (done % record_every == 0) recordState(sp, rec, stage + ".", stage, 0.0);
+    if (done % 100 != 0) continue;
+    const double err = sp.frame->stressError(), u = sim.unbalancedForceRatio();
+    control.tick(stage, sim.steps(), -1.0,
+                 "stress error " + fmt(err) + ", unbalanced force ratio " + fmt(u));
+    if (err < f.stress_tolerance && u < f.unbalanced_force_ratio) return done;
+    if (done >= max_steps) {
+      std::ostringstream why;
+      why << stage << " did not settle in " << done << " steps: the wall stresses miss their "
+          << "targets by " << fmt(err) << " (formation.stress_tolerance " << f.stress_tolerance
+          << "), the unbalanced force ratio is " << fmt(u) << " (formation.unbalanced_force_ratio "
+          << f.unbalanced_force_ratio << "); raise formation.max_steps or loosen the tolerances";
+      throw std::runtime_error(why.str());
+    }
+  }
+}
+
+// Installs the cement on every contact and near contact, unloaded, and records what it did.
+template <int D>
+void cement(Specimen<D>& sp, Recorder& rec) {
+  auto& sim = *sp.sim;
+  const CementSettings& c = sp.settings.cement;
+  sp.cement_kind = sim.addBondKind(c.kind);
+  sp.cement = sim.cement(*sp.cement_kind, c.gap_ratio);
+  rec.result("bonds_installed", static_cast<double>(sp.cement.installed), "");
+  rec.result("bonds_skipped_nonpositive", static_cast<double>(sp.cement.skipped_nonpositive), "");
+  rec.result("bonds_redrawn", static_cast<double>(sp.cement.redrawn), "");
+  rec.result("cement_candidates", static_cast<double>(sp.cement.candidates), "");
+  rec.message(sim.steps(), sim.time(), "info",
+              "cemented " + std::to_string(sp.cement.installed) + " of " +
+                  std::to_string(sp.cement.candidates) + " contacts; " +
+                  std::to_string(sp.cement.skipped_nonpositive) +
+                  " strength draws <= 0 left uncemented (bonds.negative_strength = " +
+                  (c.kind.negative == NegativeStrength::Resample ? "resample" : "skip") + ")");
+}
+
+}  // namespace
+
+template <int D>
+void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
+  using Axis = typename LoadingFrame<D>::Axis;
+  using Mode = typename LoadingFrame<D>::Mode;
+  const FormationSettings& f = sp.settings.formation;
+  auto& sim = *sp.sim;
+  // Densify isotropically at the lateral stress with the formation friction (a dense
+  // packing), then with the grains' own friction take the formation state: a deviatoric
+  // stress the low friction could not hold.
+  for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, f.lateral_stress, 0.0});
+  std::uint64_t steps = settle(sp, "densification", rec, control);
+  MaterialTable own;
+  for (const Material& m : sim.materials().all()) own.add(m);
+  own[0].friction = sp.settings.material.grain.friction;
+  sim.replaceMaterials(std::move(own));
+  for (int a = 0; a < D; ++a) {
+    const double target = a == Specimen<D>::kAxial ? f.axial_stress : f.lateral_stress;
+    sp.frame->set(a, Axis{Mode::Stress, 0.0, target, 0.0});
+  }
+  steps += settle(sp, "formation", rec, control);
+  rec.result("formation_steps", static_cast<double>(steps), "");
+  rec.result("porosity_after_formation", sp.frame->porosity(), "");
+  rec.result("coordination_after_formation", sim.coordinationNumber(), "");
+  rec.result("axial_stress_after_formation_MPa", sp.frame->stress(Specimen<D>::kAxial) / 1e6,
+             "MPa");
+  if (sp.settings.cement.enabled) cement(sp, rec);
+  sim.restartEnergyLedger();
+  sp.frame->resetReference();
+  sp.resetBrokenCount();
+  recordBreaks(sp, rec, "formation");  // the formation's, before any branch of the sample
+  snapshot(sp, rec, "formation", "formed");
+}
+
+template <int D>
+void servoTo(Specimen<D>& sp, double axial, double lateral, double rate, const std::string& stage,
+             Recorder& rec, RunControl& control) {
+  using Axis = typename LoadingFrame<D>::Axis;
+  using Mode = typename LoadingFrame<D>::Mode;
+  auto& sim = *sp.sim;
+  constexpr int ax = Specimen<D>::kAxial;
+  const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
+  std::array<double, D> from, to;
+  double span = 0.0;
+  for (int a = 0; a < D; ++a) {
+    from[a] = sp.frame->stress(a);
+    to[a] = a == ax ? axial : lateral;
+    span = std::max(span, std::abs(to[a] - from[a]));
+  }
+  const double duration = span / rate;
+  for (int a = 0; a < D; ++a) {
+    sp.frame->set(a, Axis{Mode::Stress, 0.0, from[a], (to[a] - from[a]) / duration});
+  }
+  const double t0 = sim.time();
+  while (sim.time() - t0 < duration) {
+    sp.frame->step();
+    if (sim.steps() % record_every == 0) recordState(sp, rec, stage + ".", stage, 0.0);
+    if (sim.steps() % 100 == 0) {
+      control.tick(stage, sim.steps(), (sim.time() - t0) / duration,
+                   "axial " + fmt(sp.frame->stress(ax) / 1e6) + " MPa");
+    }
+  }
+  for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, to[a], 0.0});
+  settle(sp, stage, rec, control);
+}
+
+template void formAndCement<2>(Specimen<2>&, Recorder&, RunControl&);
+template void formAndCement<3>(Specimen<3>&, Recorder&, RunControl&);
+template void servoTo<2>(Specimen<2>&, double, double, double, const std::string&, Recorder&,
+                         RunControl&);
+template void servoTo<3>(Specimen<3>&, double, double, double, const std::string&, Recorder&,
+                         RunControl&);
+
+}  // namespace rocklab::rigs
