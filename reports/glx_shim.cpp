@@ -2,7 +2,7 @@
 // for every function, and no X display exists in batch. Rendering goes to an OSMesa
 // context instead (offscreen.cpp); these two definitions, exported from the executable
 // that renders (CMake ENABLE_EXPORTS), hand GLEW OSMesa's functions. Remove this file when
-// VTK is built with OSMesa or EGL. See DEPENDENCIES.md.
+// VTK is built with OSMesa or EGL. See reports/README.md.
 
 #include <GL/osmesa.h>
 

@@ -1,6 +1,6 @@
 #pragma once
 // An off-screen canvas: an OSMesa OpenGL context around a VTK render window (the
-// workaround of DEPENDENCIES.md for the packaged VTK; the executable must also link
+// workaround of reports/README.md for the packaged VTK; the executable must also link
 // glx_shim.cpp). Everything a report draws goes through it.
 
 #include <memory>

@@ -1,7 +1,5 @@
 #include "reports/report.hpp"
 
-#include "reports/key_results.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -116,28 +114,10 @@ std::vector<BreakMark> breaksUpTo(const RunData& r, const SnapshotRow& snap) {
 
 }  // namespace
 
-ReportSummary writeReport(const ReportOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  if (o.runs.empty()) throw std::invalid_argument("report: name at least one run");
-  if (!fs::exists(o.lab)) throw std::invalid_argument("no lab notebook at '" + o.lab + "'");
-  if (o.field != "displacement" && o.field != "velocity" && o.field != "broken_bonds" &&
-      o.field != "grain") {
-    throw std::invalid_argument(
-        "report: --field must be displacement, velocity, broken_bonds or grain");
-  }
-  fs::create_directories(o.out);
-  notebook::Notebook nb(o.lab);
-  std::vector<RunData> runs;
-  for (std::int64_t id : o.runs) runs.push_back(loadRun(nb, id));
-  const Paper paper = loadPaper(o.data_dir + "/paper.toml");
-  ReportSummary summary;
+namespace {
 
-  std::ostringstream body;
-  body << "<h1>rocklab report</h1>\n<p>Lab notebook <code>" << html(o.lab) << "</code>, runs ";
-  for (std::size_t k = 0; k < runs.size(); ++k) body << (k ? ", " : "") << runs[k].id;
-  body << ".</p>\n";
-
-  // The runs at a glance.
+// The runs at a glance.
+void runsTable(std::ostream& body, const std::vector<RunData>& runs) {
   body << "<h2>Runs</h2>\n<table><tr><th>run</th><th>protocol</th><th>rig</th><th>status</th>"
           "<th>started (UTC)</th><th>wall time (s)</th><th>code version</th><th>build</th></tr>\n";
   for (const RunData& r : runs) {
@@ -148,8 +128,10 @@ ReportSummary writeReport(const ReportOptions& o) {
          << html(r.code_version) << "</code></td><td>" << html(r.build_type) << "</td></tr>\n";
   }
   body << "</table>\n";
+}
 
-  // What each protocol is for: its key results (reports/key_results.hpp), first.
+// What each protocol is for: its key results (reports/key_results.hpp).
+void keyResultsTable(std::ostream& body, const std::vector<RunData>& runs) {
   body << "<h2>Key results</h2>\n<table><tr><th>run</th><th>key result</th><th>value</th>"
           "<th>unit</th><th>meaning</th></tr>\n";
   for (const RunData& r : runs) {
@@ -160,10 +142,13 @@ ReportSummary writeReport(const ReportOptions& o) {
     }
   }
   body << "</table>\n";
+}
 
-  // Each rig's figures, the runs of that rig overlaid.
+// Each rig's figures, the runs of that rig overlaid.
+void figures(std::ostream& body, const std::vector<RunData>& runs, const Paper& paper,
+             const std::string& out, ReportSummary& summary) {
   body << "<h2>Figures</h2>\n";
-  std::size_t figures = 0;
+  std::size_t count = 0;
   for (const FigureEntry& entry : figureTable()) {
     std::vector<const RunData*> of_rig;
     for (const RunData& r : runs) {
@@ -171,55 +156,64 @@ ReportSummary writeReport(const ReportOptions& o) {
     }
     if (of_rig.empty()) continue;
     for (const Figure& f : entry.build(of_rig, paper)) {
-      renderFigure(f, o.out);
+      renderFigure(f, out);
       summary.files.push_back(f.id + ".png");
       summary.files.push_back(f.id + ".csv");
       body << "<figure><img src=\"" << f.id << ".png\" alt=\"" << html(f.title)
            << "\"><figcaption><b>" << html(f.title) << ".</b> " << html(f.caption)
            << " Data: <a href=\"" << f.id << ".csv\">" << f.id
            << ".csv</a>.</figcaption></figure>\n";
-      ++figures;
+      ++count;
     }
   }
-  if (figures == 0) body << "<p>No figures for these runs' rigs.</p>\n";
+  if (count == 0) body << "<p>No figures for these runs' rigs.</p>\n";
+}
 
-  // Snapshots rendered off screen from the state frames the runs saved.
-  if (o.snapshots) {
-    body << "<h2>Snapshots</h2>\n";
-    for (const RunData& r : runs) {
-      if (r.snapshots.empty()) continue;
-      const Frame first = readFrame(r.snapshots.front().path);
-      body << "<h3>" << html(r.label()) << "</h3>\n<div class=\"snap\">\n";
-      for (const SnapshotRow& snap : r.snapshots) {
-        const Frame f = snap.path == r.snapshots.front().path ? first : readFrame(snap.path);
-        const FieldValues v = field(o.field, f, first, r, snap);
-        const auto marks = breaksUpTo(r, snap);
-        const std::string stem =
-            "run" + std::to_string(r.id) + "-" + snap.stage + "-" + std::to_string(snap.step);
-        const std::string what =
-            snap.stage + ", " + snap.label + " (step " + std::to_string(snap.step) + ")";
-        renderView(f, v, marks, r.label() + ": " + what, o.out + "/" + stem + "-view.png");
-        summary.files.push_back(stem + "-view.png");
-        body << "<figure><img src=\"" << stem << "-view.png\" alt=\"" << html(what)
-             << "\"><figcaption>" << html(what) << ": "
-             << (f.dimension == 3 ? "the half behind the mid-plane, its cut face showing the "
-                                    "interior; "
-                                  : "")
-             << html(v.label) << ", " << marks.size() << " broken bonds of this stage marked "
-             << (f.dimension == 3 ? "near the mid-plane" : "") << ".</figcaption></figure>\n";
-        if (f.dimension == 3) {
-          renderSlice(f, v, marks, r.label() + ": " + what, o.out + "/" + stem + "-slice.png");
-          summary.files.push_back(stem + "-slice.png");
-          body << "<figure><img src=\"" << stem << "-slice.png\" alt=\"" << html(what)
-               << " section\"><figcaption>" << html(what)
-               << ": the section by the mid-plane.</figcaption></figure>\n";
-        }
-      }
-      body << "</div>\n";
+// One state frame of a run rendered off screen: the cutaway view, and in 3D the section.
+void snapshotFigures(std::ostream& body, const RunData& r, const SnapshotRow& snap, const Frame& f,
+                     const Frame& first, const std::string& colouring, const std::string& out,
+                     ReportSummary& summary) {
+  const FieldValues v = field(colouring, f, first, r, snap);
+  const auto marks = breaksUpTo(r, snap);
+  const std::string stem =
+      "run" + std::to_string(r.id) + "-" + snap.stage + "-" + std::to_string(snap.step);
+  const std::string what =
+      snap.stage + ", " + snap.label + " (step " + std::to_string(snap.step) + ")";
+  renderView(f, v, marks, r.label() + ": " + what, out + "/" + stem + "-view.png");
+  summary.files.push_back(stem + "-view.png");
+  body << "<figure><img src=\"" << stem << "-view.png\" alt=\"" << html(what) << "\"><figcaption>"
+       << html(what) << ": "
+       << (f.dimension == 3 ? "the half behind the mid-plane, its cut face showing the "
+                              "interior; "
+                            : "")
+       << html(v.label) << ", " << marks.size() << " broken bonds of this stage marked "
+       << (f.dimension == 3 ? "near the mid-plane" : "") << ".</figcaption></figure>\n";
+  if (f.dimension != 3) return;
+  renderSlice(f, v, marks, r.label() + ": " + what, out + "/" + stem + "-slice.png");
+  summary.files.push_back(stem + "-slice.png");
+  body << "<figure><img src=\"" << stem << "-slice.png\" alt=\"" << html(what)
+       << " section\"><figcaption>" << html(what)
+       << ": the section by the mid-plane.</figcaption></figure>\n";
+}
+
+// Snapshots rendered off screen from the state frames the runs saved.
+void snapshots(std::ostream& body, const std::vector<RunData>& runs, const ReportOptions& o,
+               ReportSummary& summary) {
+  body << "<h2>Snapshots</h2>\n";
+  for (const RunData& r : runs) {
+    if (r.snapshots.empty()) continue;
+    const Frame first = readFrame(r.snapshots.front().path);
+    body << "<h3>" << html(r.label()) << "</h3>\n<div class=\"snap\">\n";
+    for (const SnapshotRow& snap : r.snapshots) {
+      const Frame f = snap.path == r.snapshots.front().path ? first : readFrame(snap.path);
+      snapshotFigures(body, r, snap, f, first, o.field, o.out, summary);
     }
+    body << "</div>\n";
   }
+}
 
-  // The paper's numbers beside the runs'.
+// The paper's numbers beside the runs'.
+void paperNumbers(std::ostream& body, const std::vector<RunData>& runs, const Paper& paper) {
   body << "<h2>The paper's numbers</h2>\n<p>From <code>data/paper.toml</code>; a run's value "
           "stands beside each number it has.</p>\n<table><tr><th>number</th><th>paper</th>"
           "<th>unit</th><th>source</th>";
@@ -245,43 +239,73 @@ ReportSummary writeReport(const ReportOptions& o) {
          << html(n.source) << "</td>" << cells.str() << "</tr>\n";
   }
   body << "</table>\n";
+}
 
-  // Every run in detail.
-  body << "<h2>Run details</h2>\n";
-  for (const RunData& r : runs) {
-    body << "<h3>" << html(r.label()) << "</h3>\n<p>Protocol file <code>" << html(r.protocol_file)
-         << "</code>.</p>\n";
-    for (const auto& [level, text] : r.messages) {
-      body << "<p class=\"" << (level == "warning" ? "status-failed" : "") << "\">" << html(level)
-           << ": " << html(text) << "</p>\n";
-    }
-    body << "<details open><summary>Results</summary><table><tr><th>result</th><th>value</th>"
-            "<th>unit</th><th>paper</th></tr>\n";
-    for (const auto& [name, q] : r.results) {
-      const PaperNumber* p = paper.byResult(name);
-      body << "<tr><td>" << html(name) << "</td><td class=\"n\">" << num(q.value) << "</td><td>"
-           << html(q.unit) << "</td><td class=\"n\">" << (p ? num(p->value) : "") << "</td></tr>\n";
-    }
-    body << "</table></details>\n";
-    double total = 0.0;
-    for (const auto& t : r.timings) total += std::get<1>(t);
-    body << "<details open><summary>Time per stage</summary><table><tr><th>stage</th>"
-            "<th>seconds</th><th>calls</th><th>share</th></tr>\n";
-    for (const auto& [stage, seconds, calls] : r.timings) {
-      body << "<tr><td>" << html(stage) << "</td><td class=\"n\">" << num(seconds, 4)
-           << "</td><td class=\"n\">" << calls << "</td><td class=\"n\">"
-           << num(total > 0 ? 100.0 * seconds / total : 0.0, 3) << "%</td></tr>\n";
-    }
-    body << "</table></details>\n";
-    body << "<details><summary>Parameters</summary><table><tr><th>key</th><th>value</th>"
-            "<th>unit</th><th>paper</th></tr>\n";
-    for (const auto& [key, value, unit] : r.params) {
-      const PaperNumber* p = paper.byParam(key);
-      body << "<tr><td>" << html(key) << "</td><td>" << html(value) << "</td><td>" << html(unit)
-           << "</td><td class=\"n\">" << (p ? num(p->value) : "") << "</td></tr>\n";
-    }
-    body << "</table></details>\n";
+// One run in detail: its messages, results, time per stage and parameters.
+void runDetails(std::ostream& body, const RunData& r, const Paper& paper) {
+  body << "<h3>" << html(r.label()) << "</h3>\n<p>Protocol file <code>" << html(r.protocol_file)
+       << "</code>.</p>\n";
+  for (const auto& [level, text] : r.messages) {
+    body << "<p class=\"" << (level == "warning" ? "status-failed" : "") << "\">" << html(level)
+         << ": " << html(text) << "</p>\n";
   }
+  body << "<details open><summary>Results</summary><table><tr><th>result</th><th>value</th>"
+          "<th>unit</th><th>paper</th></tr>\n";
+  for (const auto& [name, q] : r.results) {
+    const PaperNumber* p = paper.byResult(name);
+    body << "<tr><td>" << html(name) << "</td><td class=\"n\">" << num(q.value) << "</td><td>"
+         << html(q.unit) << "</td><td class=\"n\">" << (p ? num(p->value) : "") << "</td></tr>\n";
+  }
+  body << "</table></details>\n";
+  double total = 0.0;
+  for (const auto& t : r.timings) total += std::get<1>(t);
+  body << "<details open><summary>Time per stage</summary><table><tr><th>stage</th>"
+          "<th>seconds</th><th>calls</th><th>share</th></tr>\n";
+  for (const auto& [stage, seconds, calls] : r.timings) {
+    body << "<tr><td>" << html(stage) << "</td><td class=\"n\">" << num(seconds, 4)
+         << "</td><td class=\"n\">" << calls << "</td><td class=\"n\">"
+         << num(total > 0 ? 100.0 * seconds / total : 0.0, 3) << "%</td></tr>\n";
+  }
+  body << "</table></details>\n";
+  body << "<details><summary>Parameters</summary><table><tr><th>key</th><th>value</th>"
+          "<th>unit</th><th>paper</th></tr>\n";
+  for (const auto& [key, value, unit] : r.params) {
+    const PaperNumber* p = paper.byParam(key);
+    body << "<tr><td>" << html(key) << "</td><td>" << html(value) << "</td><td>" << html(unit)
+         << "</td><td class=\"n\">" << (p ? num(p->value) : "") << "</td></tr>\n";
+  }
+  body << "</table></details>\n";
+}
+
+}  // namespace
+
+ReportSummary writeReport(const ReportOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (o.runs.empty()) throw std::invalid_argument("report: name at least one run");
+  if (!fs::exists(o.lab)) throw std::invalid_argument("no lab notebook at '" + o.lab + "'");
+  if (o.field != "displacement" && o.field != "velocity" && o.field != "broken_bonds" &&
+      o.field != "grain") {
+    throw std::invalid_argument(
+        "report: --field must be displacement, velocity, broken_bonds or grain");
+  }
+  fs::create_directories(o.out);
+  notebook::Notebook nb(o.lab);
+  std::vector<RunData> runs;
+  for (std::int64_t id : o.runs) runs.push_back(loadRun(nb, id));
+  const Paper paper = loadPaper(o.data_dir + "/paper.toml");
+  ReportSummary summary;
+
+  std::ostringstream body;
+  body << "<h1>rocklab report</h1>\n<p>Lab notebook <code>" << html(o.lab) << "</code>, runs ";
+  for (std::size_t k = 0; k < runs.size(); ++k) body << (k ? ", " : "") << runs[k].id;
+  body << ".</p>\n";
+  runsTable(body, runs);
+  keyResultsTable(body, runs);
+  figures(body, runs, paper, o.out, summary);
+  if (o.snapshots) snapshots(body, runs, o, summary);
+  paperNumbers(body, runs, paper);
+  body << "<h2>Run details</h2>\n";
+  for (const RunData& r : runs) runDetails(body, r, paper);
 
   std::ofstream index(o.out + "/index.html");
   index << page("rocklab report", body.str());

@@ -6,7 +6,20 @@
 
 namespace rocklab::reports {
 
+const SeriesData* RunData::find(const std::string& name) const {
+  if (reads) reads->series.insert(name);
+  auto it = series.find(name);
+  return it == series.end() ? nullptr : &it->second;
+}
+
+const Quantity* RunData::result(const std::string& name) const {
+  if (reads) reads->results.insert(name);
+  auto it = results.find(name);
+  return it == results.end() ? nullptr : &it->second;
+}
+
 std::string RunData::param(const std::string& key) const {
+  if (reads) reads->params.insert(key);
   for (const auto& [k, v, u] : params) {
     if (k == key) return v;
   }

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,12 @@ struct SnapshotRow {
   std::string stage, label, path;  // path resolved against the notebook
 };
 
+// The names a reader asked of a run (RunData::reads): the tests hold the report figures'
+// reads to the rigs' declared outputs, so a figure asking for a series no rig writes fails.
+struct Reads {
+  std::set<std::string> series, results, params;
+};
+
 struct RunData {
   std::int64_t id = 0;
   std::string protocol, rig, status, reason, started, code_version, build_type, protocol_file;
@@ -40,11 +47,11 @@ struct RunData {
   std::vector<notebook::EventRecord> pores;   // steady pore pressures (value), by stage
   std::vector<notebook::WaveRecord> waves;    // ultrasonic measurements with traces and picks
 
+  mutable Reads* reads = nullptr;  // when set, every lookup below is noted in it
+
   std::string label() const { return "run " + std::to_string(id) + " " + protocol; }
-  const SeriesData* find(const std::string& name) const {
-    auto it = series.find(name);
-    return it == series.end() ? nullptr : &it->second;
-  }
+  const SeriesData* find(const std::string& name) const;
+  const Quantity* result(const std::string& name) const;
   std::string param(const std::string& key) const;
 };
 

@@ -20,7 +20,7 @@ namespace rocklab {
 
 namespace {
 
-// The scene of ../shared/peers/README.md.
+// The scene of data/peers/README.md.
 constexpr double kYoung = 70e9;  // Pa
 constexpr double kPoisson = 0.25;
 constexpr double kDensity = 2650.0;  // kg/m^3

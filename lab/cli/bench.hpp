@@ -1,5 +1,5 @@
 #pragma once
-// The standard benchmark scene shared with LIGGGHTS and Yade (../shared/peers/README.md):
+// The standard benchmark scene shared with LIGGGHTS and Yade (data/peers/README.md):
 // a dense packing of spheres in a box of six frictionless walls moving inward, Hertz-
 // Mindlin contacts, a fixed time step, 100 untimed and 2000 timed steps.
 
@@ -49,7 +49,7 @@ struct BenchResult {
   double peak_rss_bytes = 0.0;  // of the process so far (getrusage)
 };
 
-// The pore network on the packing (Yade's FlowEngine figures in ../shared/peers): the first
+// The pore network on the packing (as Yade's FlowEngine builds it): the first
 // call triangulates, measures the network and solves; the repeat call, on the same
 // positions, measures and solves again.
 struct FlowBenchResult {

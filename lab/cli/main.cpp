@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "lab/cli/bench.hpp"
@@ -97,24 +98,20 @@ int runPackCommand(int dim, rocklab::PackingSpec spec, const std::string& dist, 
   return 0;
 }
 
-}  // namespace
+// A subcommand's work, set by its callback and run after parsing, so that errors are
+// reported the same way whichever command failed.
+using Action = std::function<int()>;
 
-int main(int argc, char** argv) {
-  // The chosen subcommand's work, run after parsing so errors are reported uniformly.
-  std::function<int()> action;
-  CLI::App app{
-      "rocklab: a virtual rock laboratory. Runs laboratory protocols on numerical rock "
-      "made of particles (DEM)."};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", versionLine());
-
+void addVersion(CLI::App& app, Action& action) {
   app.add_subcommand("version", "Print the version, git revision and build type")->callback([&] {
     action = [] {
       std::cout << versionLine() << "\n";
       return 0;
     };
   });
+}
 
+void addLaws(CLI::App& app, Action& action) {
   app.add_subcommand("laws", "List the contact laws and the material parameters they read")
       ->callback([&] {
         action = [] {
@@ -129,127 +126,140 @@ int main(int argc, char** argv) {
           return 0;
         };
       });
+}
 
-  rocklab::BenchOptions bench;
-  bool json = false;
+void addBench(CLI::App& app, Action& action) {
+  auto o = std::make_shared<rocklab::BenchOptions>();
+  auto json = std::make_shared<bool>(false);
   auto* b = app.add_subcommand(
       "bench",
-      "Run the benchmark scene shared with LIGGGHTS and Yade (../shared/peers): Hertz-Mindlin, "
-      "six walls closing in, dt 1.9e-7 s; prints particle-steps per second per thread count");
-  b->add_option("--packing", bench.packing, "Packing file (N, walls, x y z r per line, metres)")
+      "Run the benchmark scene shared with LIGGGHTS and Yade (data/peers): Hertz-Mindlin, six "
+      "walls closing in, dt 1.9e-7 s; prints particle-steps per second per thread count");
+  b->add_option("--packing", o->packing, "Packing file (N, walls, x y z r per line, metres)")
       ->check(CLI::ExistingFile);
-  b->add_option("--n", bench.n, "Spheres in the generated packing (without --packing)")
+  b->add_option("--n", o->n, "Spheres in the generated packing (without --packing)")
       ->check(CLI::Range(2, 100000000));
-  b->add_option("--steps", bench.steps, "Timed steps")->check(CLI::Range(1, 1000000000));
-  b->add_option("--warmup", bench.warmup, "Untimed steps before");
-  b->add_option("--threads", bench.threads, "Thread counts to run, e.g. --threads 1,2")
+  b->add_option("--steps", o->steps, "Timed steps")->check(CLI::Range(1, 1000000000));
+  b->add_option("--warmup", o->warmup, "Untimed steps before");
+  b->add_option("--threads", o->threads, "Thread counts to run, e.g. --threads 1,2")
       ->delimiter(',')
       ->check(CLI::Range(1, 1024));
-  b->add_option("--skin-m", bench.skin, "Verlet skin (m)")->check(CLI::Range(1e-9, 1.0));
-  b->add_option("--seed", bench.seed, "Seed of the generated packing");
-  b->add_flag("--energy", bench.energy, "Track contact dissipation (the peers do not)");
-  b->add_option("--save-packing", bench.save_packing, "Write the generated packing to this file");
-  b->add_option("--tile", bench.tile, "Copies of the packing along x,y,z, e.g. 5,5,4")
+  b->add_option("--skin-m", o->skin, "Verlet skin (m)")->check(CLI::Range(1e-9, 1.0));
+  b->add_option("--seed", o->seed, "Seed of the generated packing");
+  b->add_flag("--energy", o->energy, "Track contact dissipation (the peers do not)");
+  b->add_option("--save-packing", o->save_packing, "Write the generated packing to this file");
+  b->add_option("--tile", o->tile, "Copies of the packing along x,y,z, e.g. 5,5,4")
       ->delimiter(',')
       ->check(CLI::Range(1, 1000));
-  b->add_flag("--bonded", bench.bonded, "A parallel bond on every initial contact");
-  b->add_flag("--scalar-bonds", bench.scalar_bonds,
+  b->add_flag("--bonded", o->bonded, "A parallel bond on every initial contact");
+  b->add_flag("--scalar-bonds", o->scalar_bonds,
               "Bonds one at a time instead of four per AVX register (the same bits, slower)");
-  b->add_flag("--flow", bench.flow,
+  b->add_flag("--flow", o->flow,
               "Time the pore network (triangulation, network, steady solve) instead");
-  b->add_flag("--render", bench.render,
+  b->add_flag("--render", o->render,
               "Time an off-screen snapshot (bench-view.png, bench-slice.png) instead");
-  b->add_option("--render-dir", bench.render_dir, "Folder of the snapshot's PNGs")
+  b->add_option("--render-dir", o->render_dir, "Folder of the snapshot's PNGs")
       ->check(CLI::ExistingDirectory);
-  b->add_flag("--json", json, "Print JSON");
-  b->callback([&] { action = [&] { return runBenchCommand(bench, json); }; });
+  b->add_flag("--json", *json, "Print JSON");
+  b->callback([&action, o, json] { action = [o, json] { return runBenchCommand(*o, *json); }; });
+}
 
-  rocklab::cli::RunOptions run;
+void addRun(CLI::App& app, Action& action) {
+  auto o = std::make_shared<rocklab::cli::RunOptions>();
   auto* r = app.add_subcommand("run", "Run a protocol; every measurement goes to the lab notebook");
-  r->add_option("protocol", run.protocol, "Protocol file (TOML)")
+  r->add_option("protocol", o->protocol, "Protocol file (TOML)")
       ->required()
       ->check(CLI::ExistingFile);
-  r->add_option("--lab", run.lab, "Lab notebook (SQLite), created if missing");
-  r->add_flag("--quiet", run.quiet, "No progress on stderr");
-  r->add_option("--threads", run.threads, "Threads, instead of numerics.threads (same results)")
+  r->add_option("--lab", o->lab, "Lab notebook (SQLite), created if missing");
+  r->add_flag("--quiet", o->quiet, "No progress on stderr");
+  r->add_option("--threads", o->threads, "Threads, instead of numerics.threads (same results)")
       ->check(CLI::Range(1, 1024));
-  r->callback([&] { action = [&] { return rocklab::cli::runProtocol(run); }; });
+  r->callback([&action, o] { action = [o] { return rocklab::cli::runProtocol(*o); }; });
+}
 
-  std::string check_file;
+void addCheckAndKeys(CLI::App& app, Action& action) {
+  auto file = std::make_shared<std::string>();
   auto* c = app.add_subcommand("check", "Validate a protocol without running it");
-  c->add_option("protocol", check_file, "Protocol file (TOML)")->required();
-  c->callback([&] { action = [&] { return rocklab::cli::checkProtocol(check_file); }; });
+  c->add_option("protocol", *file, "Protocol file (TOML)")->required();
+  c->callback([&action, file] { action = [file] { return rocklab::cli::checkProtocol(*file); }; });
 
-  std::string keys_rig;
-  auto* k =
-      app.add_subcommand("keys", "List a rig's protocol keys with units, defaults and ranges");
-  k->add_option("rig", keys_rig,
-                "oedometer, biaxial, envelope, hydrostatic, permeameter, ultrasonic")
+  auto rig = std::make_shared<std::string>();
+  auto* k = app.add_subcommand(
+      "keys", "List a rig's protocol keys (units, defaults, ranges), key results and outputs");
+  k->add_option("rig", *rig, "oedometer, biaxial, envelope, hydrostatic, permeameter, ultrasonic")
       ->required();
-  k->callback([&] { action = [&] { return rocklab::cli::listKeys(keys_rig); }; });
+  k->callback([&action, rig] { action = [rig] { return rocklab::cli::listKeys(*rig); }; });
+}
 
-  rocklab::cli::NotebookOptions nbo;
+void addNotebook(CLI::App& app, Action& action) {
+  auto o = std::make_shared<rocklab::cli::NotebookOptions>();
   auto* nbc = app.add_subcommand("notebook", "Query the lab notebook");
-  nbc->add_option("--lab", nbo.lab, "Lab notebook (SQLite)");
-  nbc->add_flag("--csv", nbo.csv, "Print CSV");
+  nbc->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+  nbc->add_flag("--csv", o->csv, "Print CSV");
   nbc->require_subcommand(1);
-  nbc->add_subcommand("runs", "List the runs")->callback([&] { nbo.what = "runs"; });
+  nbc->add_subcommand("runs", "List the runs")->callback([o] { o->what = "runs"; });
   auto* show = nbc->add_subcommand("show", "A run: its row, parameters, results, timings");
-  show->add_option("run", nbo.run, "Run id")->required();
-  show->callback([&] { nbo.what = "show"; });
+  show->add_option("run", o->run, "Run id")->required();
+  show->callback([o] { o->what = "show"; });
   auto* ser = nbc->add_subcommand("series", "A run's time series (long form)");
-  ser->add_option("run", nbo.run, "Run id")->required();
-  ser->add_option("names", nbo.names, "Series names (all when none)");
-  ser->callback([&] { nbo.what = "series"; });
+  ser->add_option("run", o->run, "Run id")->required();
+  ser->add_option("names", o->names, "Series names (all when none)");
+  ser->callback([o] { o->what = "series"; });
   auto* ev = nbc->add_subcommand("events", "A run's events (bond breaks ...)");
-  ev->add_option("run", nbo.run, "Run id")->required();
-  ev->add_option("--kind", nbo.kind, "Only events of this kind");
-  ev->callback([&] { nbo.what = "events"; });
+  ev->add_option("run", o->run, "Run id")->required();
+  ev->add_option("--kind", o->kind, "Only events of this kind");
+  ev->callback([o] { o->what = "events"; });
   auto* sql = nbc->add_subcommand("sql", "Any SQL query");
-  sql->add_option("query", nbo.sql, "SQL")->required();
-  sql->callback([&] { nbo.what = "sql"; });
+  sql->add_option("query", o->sql, "SQL")->required();
+  sql->callback([o] { o->what = "sql"; });
   for (auto* sub : {show, ser, ev, sql, nbc->get_subcommand("runs")}) {
-    sub->add_option("--lab", nbo.lab, "Lab notebook (SQLite)");
-    sub->add_flag("--csv", nbo.csv, "Print CSV");
+    sub->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+    sub->add_flag("--csv", o->csv, "Print CSV");
   }
-  nbc->callback([&] { action = [&] { return rocklab::cli::notebookCommand(nbo); }; });
+  nbc->callback([&action, o] { action = [o] { return rocklab::cli::notebookCommand(*o); }; });
+}
 
-  rocklab::reports::ReportOptions report;
-  report.data_dir = ROCKLAB_DATA_DIR;
+void addReportAndExport(CLI::App& app, Action& action) {
+  auto o = std::make_shared<rocklab::reports::ReportOptions>();
+  o->data_dir = ROCKLAB_DATA_DIR;
   auto* rep =
       app.add_subcommand("report",
                          "Write a figure report of runs: index.html, PNG figures with their CSV, "
                          "snapshots rendered off screen, the paper's numbers beside the runs'");
-  rep->add_option("runs", report.runs, "Run ids (their figures overlay)")->required();
-  rep->add_option("--lab", report.lab, "Lab notebook (SQLite)");
-  rep->add_option("--out", report.out, "Output folder")->required();
-  rep->add_option("--field", report.field, "Snapshot colouring")
+  rep->add_option("runs", o->runs, "Run ids (their figures overlay)")->required();
+  rep->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+  rep->add_option("--out", o->out, "Output folder")->required();
+  rep->add_option("--field", o->field, "Snapshot colouring")
       ->check(CLI::IsMember({"displacement", "velocity", "broken_bonds", "grain"}));
-  rep->add_option("--data", report.data_dir, "Folder holding paper.toml");
-  rep->callback([&] {
-    action = [&] {
-      const auto s = rocklab::reports::writeReport(report);
-      std::cout << "wrote " << report.out << "/index.html (" << s.files.size() << " files, "
+  rep->add_option("--data", o->data_dir, "Folder holding paper.toml");
+  rep->callback([&action, o] {
+    action = [o] {
+      const auto s = rocklab::reports::writeReport(*o);
+      std::cout << "wrote " << o->out << "/index.html (" << s.files.size() << " files, "
                 << static_cast<int>(s.seconds + 0.5) << " s)\n";
       return 0;
     };
   });
 
-  std::string export_lab = "lab.sqlite", export_dir;
-  std::int64_t export_run = 0;
+  struct Export {
+    std::string lab = "lab.sqlite", dir;
+    std::int64_t run = 0;
+  };
+  auto e = std::make_shared<Export>();
   auto* exp = app.add_subcommand("export", "Write a run's state frames for ParaView");
-  exp->add_option("run", export_run, "Run id")->required();
-  exp->add_option("--vtk", export_dir, "Output folder (.vtp per frame and a .pvd)")->required();
-  exp->add_option("--lab", export_lab, "Lab notebook (SQLite)");
-  exp->callback([&] {
-    action = [&] {
-      std::cout << "wrote " << rocklab::reports::exportRun(export_lab, export_run, export_dir)
-                << "\n";
+  exp->add_option("run", e->run, "Run id")->required();
+  exp->add_option("--vtk", e->dir, "Output folder (.vtp per frame and a .pvd)")->required();
+  exp->add_option("--lab", e->lab, "Lab notebook (SQLite)");
+  exp->callback([&action, e] {
+    action = [e] {
+      std::cout << "wrote " << rocklab::reports::exportRun(e->lab, e->run, e->dir) << "\n";
       return 0;
     };
   });
+}
 
-  rocklab::cli::StudyOptions study;
+void addStudy(CLI::App& app, Action& action) {
+  auto o = std::make_shared<rocklab::cli::StudyOptions>();
   auto* st = app.add_subcommand("study", "Studies over many runs of a protocol");
   st->require_subcommand(1);
   auto* acc = st->add_subcommand(
@@ -257,96 +267,128 @@ int main(int argc, char** argv) {
       "Run a protocol over a ladder of numerical settings; report each setting's wall time and "
       "the deviation of the protocol's key results from the finest (the first value of each "
       "--vary), the Pareto front and the cheapest setting within --tolerance");
-  acc->add_option("protocol", study.protocol, "Protocol file (TOML)")
+  acc->add_option("protocol", o->protocol, "Protocol file (TOML)")
       ->required()
       ->check(CLI::ExistingFile);
-  acc->add_option("--vary", study.vary,
+  acc->add_option("--vary", o->vary,
                   "KEY=v1,v2,...: a protocol key and its values, finest first (repeat for more "
                   "keys: every combination runs)")
       ->required()
       ->allow_extra_args(false);
-  acc->add_option("--lab", study.lab, "Lab notebook (SQLite), created if missing");
-  acc->add_option("--out", study.out, "Output folder of the study report")->required();
-  acc->add_option("--tolerance", study.tolerance_percent,
+  acc->add_option("--lab", o->lab, "Lab notebook (SQLite), created if missing");
+  acc->add_option("--out", o->out, "Output folder of the study report")->required();
+  acc->add_option("--tolerance", o->tolerance_percent,
                   "Largest deviation of a key result accepted (%), to name the cheapest setting")
       ->check(CLI::Range(1e-6, 1e6));
-  acc->add_option("--threads", study.threads, "Threads of every run (same results)")
+  acc->add_option("--threads", o->threads, "Threads of every run (same results)")
       ->check(CLI::Range(1, 1024));
-  acc->add_flag("--quiet", study.quiet, "No progress line on stderr");
-  acc->add_flag("--dry-run", study.dry_run, "Check every setting and list them; run nothing");
-  acc->callback([&] { action = [&] { return rocklab::cli::studyAccuracy(study); }; });
+  acc->add_flag("--quiet", o->quiet, "No progress line on stderr");
+  acc->add_flag("--dry-run", o->dry_run, "Check every setting and list them; run nothing");
+  acc->callback([&action, o] { action = [o] { return rocklab::cli::studyAccuracy(*o); }; });
 
-  std::vector<std::int64_t> study_runs;
+  auto runs = std::make_shared<std::vector<std::int64_t>>();
   auto* sr = st->add_subcommand(
       "report", "Write the report of a study from its runs in the notebook, the finest first");
-  sr->add_option("runs", study_runs, "Run ids of one protocol, the finest setting first")
-      ->required();
-  sr->add_option("--lab", study.lab, "Lab notebook (SQLite)");
-  sr->add_option("--out", study.out, "Output folder of the study report")->required();
-  sr->add_option("--tolerance", study.tolerance_percent,
+  sr->add_option("runs", *runs, "Run ids of one protocol, the finest setting first")->required();
+  sr->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+  sr->add_option("--out", o->out, "Output folder of the study report")->required();
+  sr->add_option("--tolerance", o->tolerance_percent,
                  "Largest deviation of a key result accepted (%), to name the cheapest setting")
       ->check(CLI::Range(1e-6, 1e6));
-  sr->callback([&] {
-    action = [&] {
-      return rocklab::cli::studyReport(study_runs, study.lab, study.out, study.tolerance_percent);
+  sr->callback([&action, o, runs] {
+    action = [o, runs] {
+      return rocklab::cli::studyReport(*runs, o->lab, o->out, o->tolerance_percent);
     };
   });
+}
 
-  std::string reference, regress_lab = "lab.sqlite";
-  std::int64_t regress_run = 0;
-  rocklab::cli::RegressUpdateOptions update;
+void addRegress(CLI::App& app, Action& action) {
+  struct Check {
+    std::string reference, lab = "lab.sqlite";
+    std::int64_t run = 0;
+  };
+  auto c = std::make_shared<Check>();
   auto* rg = app.add_subcommand(
       "regress", "Key results against reference files (the regression guard), and regenerate them");
   rg->require_subcommand(1);
   auto* rgc = rg->add_subcommand("check", "Compare a run's key results with a reference file");
-  rgc->add_option("reference", reference, "Reference file (tests/reference/NAME.toml)")->required();
-  rgc->add_option("--lab", regress_lab, "Lab notebook (SQLite)");
-  rgc->add_option("--run", regress_run, "Run id (default: the newest run of the protocol)");
-  rgc->callback([&] {
-    action = [&] { return rocklab::cli::regressCheck(reference, regress_lab, regress_run); };
+  rgc->add_option("reference", c->reference, "Reference file (tests/reference/NAME.toml)")
+      ->required();
+  rgc->add_option("--lab", c->lab, "Lab notebook (SQLite)");
+  rgc->add_option("--run", c->run, "Run id (default: the newest run of the protocol)");
+  rgc->callback([&action, c] {
+    action = [c] { return rocklab::cli::regressCheck(c->reference, c->lab, c->run); };
   });
+  auto u = std::make_shared<rocklab::cli::RegressUpdateOptions>();
   auto* rgu = rg->add_subcommand(
       "update",
       "Run protocols at several seeds and write their reference files: the value at the "
       "protocol's seed, the tolerance from the seeds' spread");
-  rgu->add_option("protocols", update.protocols, "Protocol files")
+  rgu->add_option("protocols", u->protocols, "Protocol files")
       ->required()
       ->check(CLI::ExistingFile);
-  rgu->add_option("--out", update.out, "Folder of the reference files");
-  rgu->add_option("--lab", update.lab, "Lab notebook the runs go to");
-  rgu->add_option("--seeds", update.seeds, "Seeds per protocol")->check(CLI::Range(2, 100));
-  rgu->add_option("--threads", update.threads, "Threads of every run")->check(CLI::Range(1, 1024));
-  rgu->callback([&] { action = [&] { return rocklab::cli::regressUpdate(update); }; });
+  rgu->add_option("--out", u->out, "Folder of the reference files");
+  rgu->add_option("--lab", u->lab, "Lab notebook the runs go to");
+  rgu->add_option("--seeds", u->seeds, "Seeds per protocol")->check(CLI::Range(2, 100));
+  rgu->add_option("--threads", u->threads, "Threads of every run")->check(CLI::Range(1, 1024));
+  rgu->callback([&action, u] { action = [u] { return rocklab::cli::regressUpdate(*u); }; });
+}
 
-  int dim = 3;
-  rocklab::PackingSpec spec;
-  std::string dist = "uniform", out;
-  double dmin = 1.8, dmax = 2.2, dmean = 2.0, dstd = 0.1, phi_mean = -1.0, phi_std = 0.1;
+void addPack(CLI::App& app, Action& action) {
+  struct Pack {
+    int dim = 3;
+    rocklab::PackingSpec spec;
+    std::string dist = "uniform", out;
+    double dmin = 1.8, dmax = 2.2, dmean = 2.0, dstd = 0.1, phi_mean = -1.0, phi_std = 0.1;
+  };
+  auto o = std::make_shared<Pack>();
   auto* p = app.add_subcommand(
       "pack",
       "Generate a packing: random placement, then radius expansion in a fixed box to a "
       "target porosity");
-  p->add_option("--dim", dim, "2 (disks) or 3 (spheres)")->check(CLI::IsMember({2, 3}));
-  p->add_option("--n", spec.count, "Particles")->check(CLI::Range(1, 50000000));
-  p->add_option("--dist", dist, "Size distribution: uniform, normal or phi (Gaussian in phi)")
+  p->add_option("--dim", o->dim, "2 (disks) or 3 (spheres)")->check(CLI::IsMember({2, 3}));
+  p->add_option("--n", o->spec.count, "Particles")->check(CLI::Range(2, 50000000));
+  p->add_option("--dist", o->dist, "Size distribution: uniform, normal or phi (Gaussian in phi)")
       ->check(CLI::IsMember({"uniform", "normal", "phi"}));
-  p->add_option("--d-min-mm", dmin, "Smallest diameter (mm)")->check(CLI::PositiveNumber);
-  p->add_option("--d-max-mm", dmax, "Largest diameter (mm)")->check(CLI::PositiveNumber);
-  p->add_option("--d-mean-mm", dmean, "Mean diameter, normal distribution (mm)");
-  p->add_option("--d-std-mm", dstd, "Diameter standard deviation, normal distribution (mm)");
-  p->add_option("--phi-mean", phi_mean, "Mean of phi = -log2(d / 1 mm), phi distribution");
-  p->add_option("--phi-std", phi_std, "Standard deviation of phi, phi distribution");
-  p->add_option("--porosity", spec.porosity, "Target porosity (-)")->check(CLI::Range(0.01, 0.99));
-  p->add_option("--thickness-m", spec.thickness, "Disk thickness in 2D (m)");
-  p->add_option("--seed", spec.seed, "Random seed");
-  p->add_option("--threads", spec.threads, "Threads")->check(CLI::Range(1, 1024));
-  p->add_option("--out", out, "Output packing file")->required();
-  p->callback([&] {
-    action = [&] {
-      return runPackCommand(dim, spec, dist, dmin, dmax, dmean, dstd, phi_mean, phi_std, out);
+  p->add_option("--d-min-mm", o->dmin, "Smallest diameter (mm)")->check(CLI::PositiveNumber);
+  p->add_option("--d-max-mm", o->dmax, "Largest diameter (mm)")->check(CLI::PositiveNumber);
+  p->add_option("--d-mean-mm", o->dmean, "Mean diameter, normal distribution (mm)");
+  p->add_option("--d-std-mm", o->dstd, "Diameter standard deviation, normal distribution (mm)");
+  p->add_option("--phi-mean", o->phi_mean, "Mean of phi = -log2(d / 1 mm), phi distribution");
+  p->add_option("--phi-std", o->phi_std, "Standard deviation of phi, phi distribution");
+  p->add_option("--porosity", o->spec.porosity, "Target porosity (-)")
+      ->check(CLI::Range(0.05, 0.9));
+  p->add_option("--thickness-m", o->spec.thickness, "Disk thickness in 2D (m)");
+  p->add_option("--seed", o->spec.seed, "Random seed");
+  p->add_option("--threads", o->spec.threads, "Threads")->check(CLI::Range(1, 1024));
+  p->add_option("--out", o->out, "Output packing file")->required();
+  p->callback([&action, o] {
+    action = [o] {
+      return runPackCommand(o->dim, o->spec, o->dist, o->dmin, o->dmax, o->dmean, o->dstd,
+                            o->phi_mean, o->phi_std, o->out);
     };
   });
+}
 
+}  // namespace
+
+int main(int argc, char** argv) {
+  Action action;
+  CLI::App app{
+      "rocklab: a virtual rock laboratory. Runs laboratory protocols on numerical rock "
+      "made of particles (DEM)."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", versionLine());
+  addVersion(app, action);
+  addLaws(app, action);
+  addBench(app, action);
+  addRun(app, action);
+  addCheckAndKeys(app, action);
+  addNotebook(app, action);
+  addReportAndExport(app, action);
+  addStudy(app, action);
+  addRegress(app, action);
+  addPack(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -246,6 +246,79 @@ int regressCheck(const std::string& reference, const std::string& lab, std::int6
   return ok ? 0 : 1;
 }
 
+namespace {
+
+// A protocol run at `seeds` seeds from its own; the runs' data, or fewer when one failed.
+std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const std::string& file,
+                                         const RegressUpdateOptions& o, bool& interrupted) {
+  const std::int64_t seed0 = c.settings.integer("protocol.seed");
+  std::vector<reports::RunData> runs;
+  for (int k = 0; k < o.seeds; ++k) {
+    protocol::Settings s = c.settings;
+    s.override("protocol.seed", seed0 + k);
+    if (o.threads > 0) s.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+    const RunOutcome r = runSettings(*c.rig, s, file, o.lab, true);
+    if (r.code == 130) interrupted = true;
+    if (r.code != 0) {
+      if (!interrupted) {
+        std::cerr << file << ": run " << r.run << " at seed " << seed0 + k
+                  << " did not complete: no reference written for it\n";
+      }
+      break;
+    }
+    notebook::Notebook nb(o.lab);
+    runs.push_back(reports::loadRun(nb, r.run));
+  }
+  return runs;
+}
+
+// The reference file of a protocol from its runs at successive seeds: each key result's
+// value at the protocol's own seed and a tolerance from their spread.
+std::string referenceFile(const rigs::CheckedProtocol& c,
+                          const std::vector<reports::RunData>& runs) {
+  const std::string name = c.settings.text("protocol.name");
+  const std::int64_t seed0 = c.settings.integer("protocol.seed");
+  std::ostringstream file;
+  file << "# Key results of " << name << " guarded by the regression test (tests/e2e).\n"
+       << "# Written by `rocklab regress update` at git " << kGitRevision
+       << "; review the diff before committing.\n"
+       << "# value: at the protocol's own seed (" << seed0 << "), as the test runs it.\n"
+       << "# tolerance: twice the spread over seeds " << seed0 << "-"
+       << seed0 + static_cast<std::int64_t>(runs.size()) - 1
+       << ", at least 1% of the value: a change that only\n"
+       << "# reorders floating-point sums moves a result like another seed does; one beyond "
+          "that\n# changed the physics.\n"
+       << "protocol = \"" << name << "\"\n";
+  std::string unguarded;
+  for (const std::string& key : c.settings.texts("protocol.key_results")) {
+    std::vector<double> v;
+    for (const reports::RunData& r : runs) {
+      if (const auto x = reports::evaluateKeyResult(r, key)) v.push_back(*x);
+    }
+    // A key result some seed does not record (no band found, a pulse drowned) cannot be
+    // held to a value: it is listed, not guarded.
+    if (v.size() < runs.size()) {
+      unguarded += "#   " + key + ": recorded at " + std::to_string(v.size()) + " of " +
+                   std::to_string(runs.size()) + " seeds\n";
+      std::cerr << name << ": key result '" << key << "' recorded at " << v.size() << " of "
+                << runs.size() << " seeds: not guarded\n";
+      continue;
+    }
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    const double tolerance = std::max(2.0 * (*hi - *lo), 0.01 * std::abs(v.front()));
+    const std::string quoted = key.find('.') == std::string::npos ? key : "\"" + key + "\"";
+    file << "\n[results." << quoted << "]\nvalue = " << fmt(v.front())
+         << "\ntolerance = " << fmt(tolerance) << "\nunit = \""
+         << c.rig->outputs().keyResult(key)->unit << "\"\nseeds = [";
+    for (std::size_t k = 0; k < v.size(); ++k) file << (k ? ", " : "") << fmt(v[k]);
+    file << "]\n";
+  }
+  if (!unguarded.empty()) file << "\n# Not guarded (not recorded at every seed):\n" << unguarded;
+  return file.str();
+}
+
+}  // namespace
+
 int regressUpdate(const RegressUpdateOptions& o) {
   if (o.seeds < 2) {
     std::cerr << "regress update: --seeds must be at least 2 (the tolerance is their spread)\n";
@@ -267,64 +340,16 @@ int regressUpdate(const RegressUpdateOptions& o) {
   std::filesystem::create_directories(o.out);
   bool failed = false;
   for (std::size_t p = 0; p < checked.size(); ++p) {
-    const rigs::CheckedProtocol& c = checked[p];
-    const std::int64_t seed0 = c.settings.integer("protocol.seed");
-    std::vector<reports::RunData> runs;
-    for (int k = 0; k < o.seeds; ++k) {
-      protocol::Settings s = c.settings;
-      s.override("protocol.seed", seed0 + k);
-      if (o.threads > 0) s.override("numerics.threads", static_cast<std::int64_t>(o.threads));
-      const RunOutcome r = runSettings(*c.rig, s, o.protocols[p], o.lab, true);
-      if (r.code == 130) return 130;
-      if (r.code != 0) {
-        std::cerr << o.protocols[p] << ": run " << r.run << " at seed " << seed0 + k
-                  << " did not complete: no reference written for it\n";
-        failed = true;
-        break;
-      }
-      notebook::Notebook nb(o.lab);
-      runs.push_back(reports::loadRun(nb, r.run));
+    bool interrupted = false;
+    const auto runs = runAtSeeds(checked[p], o.protocols[p], o, interrupted);
+    if (interrupted) return 130;
+    if (runs.size() < static_cast<std::size_t>(o.seeds)) {
+      failed = true;
+      continue;
     }
-    if (runs.size() < static_cast<std::size_t>(o.seeds)) continue;
-    const std::string name = c.settings.text("protocol.name");
-    const std::string path = o.out + "/" + name + ".toml";
-    std::ostringstream file;
-    file << "# Key results of " << name << " guarded by the regression test (tests/e2e).\n"
-         << "# Written by `rocklab regress update` at git " << kGitRevision
-         << "; review the diff before committing.\n"
-         << "# value: at the protocol's own seed (" << seed0 << "), as the test runs it.\n"
-         << "# tolerance: twice the spread over seeds " << seed0 << "-" << seed0 + o.seeds - 1
-         << ", at least 1% of the value: a change that only\n"
-         << "# reorders floating-point sums moves a result like another seed does; one beyond "
-            "that\n# changed the physics.\n"
-         << "protocol = \"" << name << "\"\n";
-    std::string unguarded;
-    for (const std::string& key : c.settings.texts("protocol.key_results")) {
-      std::vector<double> v;
-      for (const reports::RunData& r : runs) {
-        if (const auto x = reports::evaluateKeyResult(r, key)) v.push_back(*x);
-      }
-      // A key result some seed does not record (no band found, a pulse drowned) cannot be
-      // held to a value: it is listed, not guarded.
-      if (v.size() < runs.size()) {
-        unguarded += "#   " + key + ": recorded at " + std::to_string(v.size()) + " of " +
-                     std::to_string(runs.size()) + " seeds\n";
-        std::cerr << name << ": key result '" << key << "' recorded at " << v.size() << " of "
-                  << runs.size() << " seeds: not guarded\n";
-        continue;
-      }
-      const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
-      const double tolerance = std::max(2.0 * (*hi - *lo), 0.01 * std::abs(v.front()));
-      const std::string quoted = key.find('.') == std::string::npos ? key : "\"" + key + "\"";
-      file << "\n[results." << quoted << "]\nvalue = " << fmt(v.front())
-           << "\ntolerance = " << fmt(tolerance) << "\nunit = \""
-           << c.rig->outputs().keyResult(key)->unit << "\"\nseeds = [";
-      for (std::size_t k = 0; k < v.size(); ++k) file << (k ? ", " : "") << fmt(v[k]);
-      file << "]\n";
-    }
-    if (!unguarded.empty()) file << "\n# Not guarded (not recorded at every seed):\n" << unguarded;
+    const std::string path = o.out + "/" + checked[p].settings.text("protocol.name") + ".toml";
     std::ofstream out(path);
-    out << file.str();
+    out << referenceFile(checked[p], runs);
     if (!out) {
       std::cerr << "cannot write " << path << "\n";
       return 1;

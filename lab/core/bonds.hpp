@@ -28,7 +28,7 @@ enum class NegativeStrength : std::uint8_t { Skip, Resample };
 enum class BondBreakMode : std::uint8_t { Tensile, Shear };
 
 // A family of bonds with their properties. The defaults are the paper's cement (section
-// 1.1: bond modulus 4 GPa, kn/ks 0.5, strengths 8 +- 8 MPa); `grains()` gives those of the
+// 1: bond modulus 4 GPa, kn/ks 0.5, strengths 8 +- 8 MPa); `grains()` gives those of the
 // intragranular bonds of breakable grains (section 2.2). One declaration serves both
 // protocol sections, `bonds.*` and `grain_bonds.*`.
 struct BondKind {

@@ -38,9 +38,6 @@ struct ContactPass {
   bool overlap_exceeded = false;
 };
 
-// One pair's or wall contact's result, kept where another thread or a later serial sum
-// must apply it in the serial order. `diss` holds what the contact alone dissipated, so
-// adding it to a running total gives the same bits as the serial accumulation.
 // One pair's force on j and torques (lever arm times n x F_t) on i and on j.
 template <int D>
 struct PairForce {

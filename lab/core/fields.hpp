@@ -89,8 +89,10 @@ struct Range {
   }
   // "(0, 10000]"
   std::string text() const {
-    return std::string(lo_open ? "(" : "[") + formatNumber(lo) + ", " + formatNumber(hi) +
-           (hi_open ? ")" : "]");
+    std::ostringstream s;
+    s.precision(10);
+    s << (lo_open ? "(" : "[") << lo << ", " << hi << (hi_open ? ")" : "]");
+    return s.str();
   }
   // Ten significant digits, as protocols and `rocklab keys` show numbers.
   static std::string formatNumber(double v) {

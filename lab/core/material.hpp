@@ -16,7 +16,7 @@ namespace rocklab {
 // Parameters a contact law may read. Each law declares the ones of its own a protocol sets
 // (contact_laws.hpp) and validates them before a run starts; the common ones are declared
 // here. The defaults are quartz grains (Hertz) and the paper's linear contacts (a contact
-// modulus of 4 GPa, section 1.1).
+// modulus of 4 GPa, section 1).
 struct Material {
   std::string name = "default";
   double density = 2650.0;       // kg/m^3, for scene builders: particles carry their own

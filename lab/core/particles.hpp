@@ -94,7 +94,7 @@ class ParticleStore {
   // Reorders every array so that new index k holds the particle that was at order[k].
   void permute(const std::vector<std::uint32_t>& order);
 
-  // The slot bookkeeping, for checkpoints (one serializer visits it; see checkpoint.hpp).
+  // The slot bookkeeping, for checkpoints (one serializer visits it; see archive.hpp).
   template <class Archive>
   void visit(Archive& ar) {
     ar("thickness", thickness);

@@ -9,7 +9,6 @@
 // change the run.
 
 #include <array>
-#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -28,6 +27,7 @@
 #include "lab/core/neighbors.hpp"
 #include "lab/core/particles.hpp"
 #include "lab/core/random.hpp"
+#include "lab/core/stage_clock.hpp"
 #include "lab/core/walls.hpp"
 
 namespace rocklab {
@@ -224,7 +224,7 @@ class Simulation {
   // Every clump break since the scene began, oldest first (as bondBreaks()).
   const std::vector<ClumpBreak<D>>& clumpBreaks() const { return clump_breaks_; }
 
-  // --- driven particles (a wave transmitter, DESIGN.md Waves) ---
+  // --- driven particles (a wave transmitter, rigs/ultrasonic/README.md) ---
   // Makes the particles at these slots driven: infinite mass and inertia, no spin, moving
   // with the velocity setDrivenVelocity gives them whatever the forces on them; their work
   // on the others is booked as boundary work. Clump pebbles cannot be driven.
@@ -287,6 +287,7 @@ class Simulation {
   // step); returns whether an overlap exceeded the guard's limit.
   bool computeForces(double history_dt);
   void computeBondForces(double dt);
+  void applyGravity(double dt);
   void applyForces(double dt);
   void integrateClumpsFirstHalf(double& max_speed);
   void integrateClumpsSecondHalf(double& kinetic, double& damping, double& body_work);
@@ -299,6 +300,7 @@ class Simulation {
   void finalIntegrate();
   bool needsRebuild();
   void rebuild();
+  void sortAlongGrid();
   void guard(bool overlap_exceeded);
   [[noreturn]] void fail(SimulationUnstable::Cause cause, const std::string& what) const;
   std::string diagnose() const;
@@ -347,8 +349,7 @@ class Simulation {
   // `torque` stay the physical unbalanced force; allocated only when damping is on.
   std::vector<V> damp_force_;
   std::vector<A> damp_torque_;
-  std::array<double, kStages> stage_seconds_{};
-  std::array<std::uint64_t, kStages> stage_calls_{};
+  std::array<StageTime, kStages> stages_{};
 };
 
 }  // namespace rocklab

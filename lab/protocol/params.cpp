@@ -271,17 +271,134 @@ std::string rigOf(const std::string& file, const std::string& text) {
   return root.at("protocol").at("rig").as_string().str;
 }
 
+namespace {
+
+// The problems found in a protocol file, each at its line, reported in line order.
+class Problems {
+ public:
+  explicit Problems(std::string file) : file_(std::move(file)) {}
+  void at(int line, const std::string& what) {
+    list_.emplace_back(line, file_ + ":" + std::to_string(line) + ": " + what);
+  }
+  void unplaced(const std::string& what) { list_.emplace_back(1 << 30, file_ + ": " + what); }
+  void throwIfAny() {
+    if (list_.empty()) return;
+    std::stable_sort(list_.begin(), list_.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<std::string> lines;
+    for (auto& p : list_) lines.push_back(std::move(p.second));
+    throw ProtocolError(lines);
+  }
+
+ private:
+  std::string file_;
+  std::vector<std::pair<int, std::string>> list_;
+};
+
+// The declaration of a key the file gives, or nullptr with the problem noted: a key of
+// another rig, or an unknown key with the nearest known one.
+const ParamDecl* declarationOf(const Schema& schema, const std::string& key, int line,
+                               Problems& problems) {
+  if (const ParamDecl* d = schema.find(key)) return d;
+  if (!schema.foreignRigs(key).empty()) {
+    problems.at(line, "'" + key + "' is a key of the " + schema.foreignRigs(key) + " rig: the " +
+                          schema.rig() +
+                          " rig has no use for it (a scene runs only the effects its rig can "
+                          "use; remove the key or name that rig in protocol.rig)");
+    return nullptr;
+  }
+  std::string best;
+  std::size_t best_d = 4;
+  for (const ParamDecl& c : schema.all()) {
+    const std::size_t e = editDistance(key, c.key);
+    if (e < best_d) best_d = e, best = c.key;
+  }
+  problems.at(line, "unknown key '" + key + "'" +
+                        (best.empty() ? "" : "; did you mean '" + best + "'?") +
+                        " (`rocklab keys RIG` lists them)");
+  return nullptr;
+}
+
+// A TOML value as the declared kind, its range and choices checked; none (the problem
+// noted) when it is not of that kind.
+std::optional<Value> valueOf(const ParamDecl& d, const TomlValue& v, int line, Problems& problems) {
+  const std::string expect = "'" + d.key + "'" + unitText(d) + " expects ";
+  auto checkRange = [&](double x) {
+    if (!inRange(d, x)) {
+      problems.at(line, d.key + " = " + number(x) + " is outside the allowed range " +
+                            d.rangeText() + unitText(d));
+    }
+  };
+  auto wrong = [&](const std::string& what) -> std::optional<Value> {
+    problems.at(line, expect + what);
+    return std::nullopt;
+  };
+  switch (d.kind) {
+    case Kind::Real: {
+      if (!v.is_floating() && !v.is_integer()) return wrong("a number");
+      const double x = v.is_floating() ? v.as_floating() : static_cast<double>(v.as_integer());
+      checkRange(x);
+      return x;
+    }
+    case Kind::Integer:
+      if (!v.is_integer()) return wrong("an integer");
+      checkRange(static_cast<double>(v.as_integer()));
+      return static_cast<std::int64_t>(v.as_integer());
+    case Kind::Text:
+    case Kind::Choice: {
+      if (!v.is_string()) {
+        return wrong("a string" + (d.kind == Kind::Choice ? " (" + d.rangeText() + ")" : ""));
+      }
+      const std::string& text = v.as_string().str;
+      if (d.kind == Kind::Choice &&
+          std::find(d.choices.begin(), d.choices.end(), text) == d.choices.end()) {
+        problems.at(line, d.key + " = \"" + text + "\" is not allowed: " + d.rangeText());
+      }
+      return text;
+    }
+    case Kind::Flag:
+      if (!v.is_boolean()) return wrong("true or false");
+      return v.as_boolean();
+    case Kind::RealList: {
+      if (!v.is_array()) return wrong("a list of numbers, e.g. [0.01, 0.02]");
+      std::vector<double> list;
+      bool ok = true;
+      for (const auto& e : v.as_array()) {
+        if (e.is_floating() || e.is_integer()) {
+          list.push_back(e.is_floating() ? e.as_floating() : static_cast<double>(e.as_integer()));
+          checkRange(list.back());
+        } else {
+          ok = false;
+        }
+      }
+      if (!ok) problems.at(line, expect + "a list of numbers only");
+      return list;
+    }
+    case Kind::TextList: {
+      std::vector<std::string> list;
+      bool ok = v.is_array();
+      if (ok) {
+        for (const auto& e : v.as_array()) {
+          if (e.is_string()) list.push_back(e.as_string().str);
+          ok = ok && e.is_string();
+        }
+      }
+      if (!ok) problems.at(line, expect + "a list of strings, e.g. [\"a\", \"b\"]");
+      return list;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema) {
   const TomlValue root = parseToml(file, text);
   Settings s;
   s.schema_ = std::make_shared<const Schema>(schema);
   s.file_ = file;
   s.source_ = text;
-  std::vector<std::pair<int, std::string>> problems;
-  auto problem = [&](int line, const std::string& what) {
-    problems.emplace_back(line, file + ":" + std::to_string(line) + ": " + what);
-  };
-
+  Problems problems(file);
   auto walk = [&](auto&& self, const TomlValue& table, const std::string& prefix) -> void {
     for (const auto& [k, v] : table.as_table()) {
       const std::string key = prefix.empty() ? k : prefix + "." + k;
@@ -290,126 +407,22 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
         self(self, v, key);
         continue;
       }
-      const ParamDecl* d = schema.find(key);
-      if (!d && !schema.foreignRigs(key).empty()) {
-        problem(line, "'" + key + "' is a key of the " + schema.foreignRigs(key) + " rig: the " +
-                          schema.rig() +
-                          " rig has no use for it (a scene runs only the effects its rig "
-                          "can use; remove the key or name that rig in protocol.rig)");
-        continue;
-      }
-      if (!d) {
-        std::string best;
-        std::size_t best_d = 4;
-        for (const ParamDecl& c : schema.all()) {
-          const std::size_t e = editDistance(key, c.key);
-          if (e < best_d) best_d = e, best = c.key;
-        }
-        problem(line, "unknown key '" + key + "'" +
-                          (best.empty() ? "" : "; did you mean '" + best + "'?") +
-                          " (`rocklab keys RIG` lists them)");
-        continue;
-      }
+      const ParamDecl* d = declarationOf(schema, key, line, problems);
+      if (!d) continue;
       s.given_[key] = line;
-      const std::string expect = "'" + key + "'" + unitText(*d) + " expects ";
-      auto checkRange = [&](double x) {
-        if (!inRange(*d, x)) {
-          problem(line, key + " = " + number(x) + " is outside the allowed range " +
-                            d->rangeText() + unitText(*d));
-        }
-      };
-      switch (d->kind) {
-        case Kind::Real:
-          if (!v.is_floating() && !v.is_integer()) {
-            problem(line, expect + "a number");
-            break;
-          }
-          s.values_[key] = v.is_floating() ? v.as_floating() : static_cast<double>(v.as_integer());
-          checkRange(std::get<double>(s.values_[key]));
-          break;
-        case Kind::Integer:
-          if (!v.is_integer()) {
-            problem(line, expect + "an integer");
-            break;
-          }
-          s.values_[key] = static_cast<std::int64_t>(v.as_integer());
-          checkRange(static_cast<double>(v.as_integer()));
-          break;
-        case Kind::Text:
-        case Kind::Choice:
-          if (!v.is_string()) {
-            problem(line, expect + "a string" +
-                              (d->kind == Kind::Choice ? " (" + d->rangeText() + ")" : ""));
-            break;
-          }
-          s.values_[key] = v.as_string().str;
-          if (d->kind == Kind::Choice && std::find(d->choices.begin(), d->choices.end(),
-                                                   v.as_string().str) == d->choices.end()) {
-            problem(line,
-                    key + " = \"" + v.as_string().str + "\" is not allowed: " + d->rangeText());
-          }
-          break;
-        case Kind::Flag:
-          if (!v.is_boolean()) {
-            problem(line, expect + "true or false");
-            break;
-          }
-          s.values_[key] = v.as_boolean();
-          break;
-        case Kind::RealList: {
-          if (!v.is_array()) {
-            problem(line, expect + "a list of numbers, e.g. [0.01, 0.02]");
-            break;
-          }
-          std::vector<double> list;
-          bool ok = true;
-          for (const auto& e : v.as_array()) {
-            if (e.is_floating() || e.is_integer()) {
-              list.push_back(e.is_floating() ? e.as_floating()
-                                             : static_cast<double>(e.as_integer()));
-              checkRange(list.back());
-            } else {
-              ok = false;
-            }
-          }
-          if (!ok) problem(line, expect + "a list of numbers only");
-          s.values_[key] = list;
-          break;
-        }
-        case Kind::TextList: {
-          std::vector<std::string> list;
-          bool ok = v.is_array();
-          if (ok) {
-            for (const auto& e : v.as_array()) {
-              if (e.is_string()) list.push_back(e.as_string().str);
-              ok = ok && e.is_string();
-            }
-          }
-          if (!ok) problem(line, expect + "a list of strings, e.g. [\"a\", \"b\"]");
-          s.values_[key] = list;
-          break;
-        }
-      }
+      if (auto value = valueOf(*d, v, line, problems)) s.values_[key] = std::move(*value);
     }
   };
   walk(walk, root, "");
-
   for (const ParamDecl& d : schema.all()) {
-    if (s.values_.count(d.key)) continue;
+    if (s.given_.count(d.key)) continue;
     if (d.fallback) {
-      if (!s.given_.count(d.key)) s.values_[d.key] = *d.fallback;
-    } else if (!s.given_.count(d.key)) {
-      problems.emplace_back(
-          1 << 30, file + ": missing required key '" + d.key + "'" + unitText(d) + ": " + d.doc);
+      s.values_[d.key] = *d.fallback;
+    } else {
+      problems.unplaced("missing required key '" + d.key + "'" + unitText(d) + ": " + d.doc);
     }
   }
-  if (!problems.empty()) {
-    std::stable_sort(problems.begin(), problems.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
-    std::vector<std::string> lines;
-    for (auto& p : problems) lines.push_back(std::move(p.second));
-    throw ProtocolError(lines);
-  }
+  problems.throwIfAny();
   return s;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Signals of the ultrasonic bench (DESIGN.md, Waves): amplitude spectra, FFT cross-
+// Signals of the ultrasonic bench (rigs/ultrasonic/README.md): amplitude spectra, FFT cross-
 // correlation, arrival picks and the velocity from arrival times over several receivers.
 // FFTW stays inside signal.cpp; callers see plain vectors of samples at a constant step.
 

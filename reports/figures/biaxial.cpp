@@ -40,11 +40,6 @@ std::vector<Test> testsOf(const RunData& r) {
   return out;
 }
 
-const Quantity* result(const RunData& r, const std::string& name) {
-  auto it = r.results.find(name);
-  return it == r.results.end() ? nullptr : &it->second;
-}
-
 Figure stressStrain(const std::vector<Test>& tests, const Paper& paper, const std::string& id) {
   Figure f;
   f.id = id;
@@ -107,9 +102,9 @@ Figure failureEnvelope(const RunData& r, const std::vector<Test>& tests) {
   double last_dilatant_p = NAN, last_dilatant_q = NAN, sigma3_max = 0.0;
   for (const Test& t : tests) {
     sigma3_max = std::max(sigma3_max, t.sigma3);
-    const Quantity* q = result(r, t.prefix + "critical_deviatoric_stress_MPa");
-    const Quantity* p = result(r, t.prefix + "critical_mean_stress_MPa");
-    const Quantity* c = result(r, t.prefix + "critical_is_compaction");
+    const Quantity* q = r.result(t.prefix + "critical_deviatoric_stress_MPa");
+    const Quantity* p = r.result(t.prefix + "critical_mean_stress_MPa");
+    const Quantity* c = r.result(t.prefix + "critical_is_compaction");
     if (!q || !p || !c) continue;
     if (c->value > 0.5) {
       if (cap.x.empty() && std::isfinite(last_dilatant_p)) {
@@ -127,8 +122,8 @@ Figure failureEnvelope(const RunData& r, const std::vector<Test>& tests) {
     }
   }
   Panel pq{"mean stress p (MPa)", "deviatoric stress q (MPa)", {}};
-  const Quantity* phi = result(r, "friction_angle_deg");
-  const Quantity* ucs = result(r, "mohr_coulomb_ucs_MPa");
+  const Quantity* phi = r.result("friction_angle_deg");
+  const Quantity* ucs = r.result("mohr_coulomb_ucs_MPa");
   if (phi && ucs) {
     const double s = std::sin(phi->value * std::numbers::pi / 180.0);
     const double N = (1.0 + s) / (1.0 - s);  // tan^2(45 + phi/2)
@@ -159,7 +154,7 @@ std::vector<Figure> loadingFigures(const std::vector<const RunData*>& runs, cons
   for (const RunData* r : runs) {
     const std::vector<Test> tests = testsOf(*r);
     all.insert(all.end(), tests.begin(), tests.end());
-    if (tests.size() > 1) {
+    if (r->rig == "envelope" && tests.size() > 1) {  // a sweep's Mohr-Coulomb fit
       Figure e = failureEnvelope(*r, tests);
       if (!e.panels.empty()) out.push_back(e);
     }

@@ -165,11 +165,11 @@ Figure solverCost(const std::vector<const RunData*>& runs) {
     Series t{r->label(), {}, {}, true}, d{r->label(), {}, {}, true};
     for (int i = 0; i < 4; ++i) {
       const std::string key = std::string("solver_") + kSolvers[i];
-      auto s = r->results.find(key + "_seconds");
-      auto m = r->results.find(key + "_max_difference");
-      if (s == r->results.end() || m == r->results.end()) continue;
-      t.x.push_back(i + 1), t.y.push_back(s->second.value);
-      d.x.push_back(i + 1), d.y.push_back(m->second.value);
+      const Quantity* s = r->result(key + "_seconds");
+      const Quantity* m = r->result(key + "_max_difference");
+      if (!s || !m) continue;
+      t.x.push_back(i + 1), t.y.push_back(s->value);
+      d.x.push_back(i + 1), d.y.push_back(m->value);
     }
     if (!t.x.empty()) time.series.push_back(t), diff.series.push_back(d);
   }

@@ -1,6 +1,6 @@
 #pragma once
 // Forming a specimen under stress and moving it between stress states by servo (Li & Holt
-// section 1.1: the sample is formed under stress, then cemented, so the bonds take only
+// section 1: the sample is formed under stress, then cemented, so the bonds take only
 // what comes after).
 
 #include <string>

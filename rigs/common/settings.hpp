@@ -105,7 +105,7 @@ struct CementSettings {
   }
 };
 
-// Formation under stress (Li & Holt section 1.1): densified at the lateral stress with a low
+// Formation under stress (Li & Holt section 1): densified at the lateral stress with a low
 // friction, then brought to the formation state with the grains' own.
 struct FormationSettings {
   double axial_stress = 30.0 * kMPa;

@@ -53,24 +53,33 @@ double fitWindow(const std::vector<Sample>& pts, double lo, double hi, bool stre
   return slope(x, y);
 }
 
-// Runs the uniaxial-strain loading and records its results; returns the initial tangent
-// modulus (Pa).
+// What the loading loop keeps: every recorded point, the cycles, and how well the loading
+// was controlled.
+struct OedometricHistory {
+  std::vector<Sample> pts;
+  std::vector<Cycle> cycles;
+  std::uint64_t steps = 0;
+  double unbalanced_sum = 0.0, inertial_max = 0.0;
+  std::size_t loading_records = 0;
+  double meanUnbalanced() const { return loading_records ? unbalanced_sum / loading_records : 0.0; }
+};
+
+// Drives the axial walls (strain rate or stress ramp; the lateral walls fixed) to the end of
+// loading, cycling where asked, and records the state.
 template <int D>
-double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunControl& control,
-                      const std::string& branch) {
+OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& rec,
+                                 RunControl& control, const std::string& stage,
+                                 const std::string& prefix) {
   using Axis = typename LoadingFrame<D>::Axis;
   using Mode = typename LoadingFrame<D>::Mode;
   constexpr int ax = Specimen<D>::kAxial;
   auto& sim = *sp.sim;
   auto& frame = *sp.frame;
-  const std::string stage = branch.empty() ? "loading" : branch;
-  const std::string prefix = branch.empty() ? "" : branch + ".";
   const bool strain_control = s.control == Control::StrainRate;
   const double rate = s.axial_strain_rate;
   const double strain_max = s.axial_strain_max;
   const double stress_max = s.axial_stress_max;
   const std::vector<double>& cycle_at = s.cycle_at_axial_strain;
-  const double unload_fraction = s.cycle_unload_fraction;
   const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
   const auto snapshot_every = static_cast<std::uint64_t>(sp.settings.output.snapshot_every_steps);
 
@@ -85,12 +94,9 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
     frame.set(ax, Axis{Mode::Stress, 0.0, sigma0, s.axial_stress_rate});
   }
 
-  std::vector<Sample> pts;
-  std::vector<Cycle> cycles;
+  OedometricHistory h;
   std::size_t next_cycle = 0;
   int phase = 0;
-  double unbalanced_sum = 0.0, inertial_max = 0.0;
-  std::size_t loading_records = 0;
   const std::uint64_t start = sim.steps();
   auto lateral = [&] {
     double l = 0.0;
@@ -103,14 +109,14 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
     const double edot = phase == 1 ? -rate : rate;
     recordState(sp, rec, prefix, stage, strain_control ? edot : 0.0);
     rec.series(prefix + "phase", sim.steps(), sim.time(), phase);
-    pts.push_back(
+    h.pts.push_back(
         {frame.strain(ax), frame.stress(ax), lateral(),
          static_cast<double>(sp.broken(BondBreakMode::Tensile) + sp.broken(BondBreakMode::Shear)),
          phase});
     if (phase == 0) {
-      unbalanced_sum += sim.unbalancedForceRatio();
-      ++loading_records;
-      if (strain_control) inertial_max = std::max(inertial_max, inertialNumber(sp, rate));
+      h.unbalanced_sum += sim.unbalancedForceRatio();
+      ++h.loading_records;
+      if (strain_control) h.inertial_max = std::max(h.inertial_max, inertialNumber(sp, rate));
     }
   };
   record();
@@ -118,13 +124,15 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
     frame.step();
     const double strain = frame.strain(ax);
     const double stress = frame.stress(ax);
+    auto& cycles = h.cycles;
     if (phase == 0 && next_cycle < cycle_at.size() && strain >= cycle_at[next_cycle]) {
       record();
       cycles.push_back({cycle_at[next_cycle], stress, strain, 0, 0});
       phase = 1;
       frame.set(ax, Axis{Mode::StrainRate, -rate});
-    } else if (phase == 1 && stress <= cycles.back().peak_stress -
-                                           unload_fraction * (cycles.back().peak_stress - sigma0)) {
+    } else if (phase == 1 &&
+               stress <= cycles.back().peak_stress -
+                             s.cycle_unload_fraction * (cycles.back().peak_stress - sigma0)) {
       record();
       cycles.back().low_stress = stress;
       cycles.back().low_strain = strain;
@@ -156,8 +164,17 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
                                fmt(stress_max / 1e6) + " MPa");
     }
   }
+  h.steps = sim.steps() - start;
+  return h;
+}
 
-  // Key results of the test.
+// The test's results: tangent moduli and stress-path slopes over the first and last tenth,
+// the final state, the breaks, each cycle's moduli, the loading's control. Returns the
+// initial tangent modulus (Pa).
+template <int D>
+double recordOedometricResults(const Specimen<D>& sp, const OedometricHistory& h,
+                               bool strain_control, const std::string& prefix, Recorder& rec) {
+  const auto& pts = h.pts;
   const double eps_end = pts.back().strain;
   auto put = [&](const std::string& name, double v, const std::string& unit) {
     rec.result(prefix + name, v, unit);
@@ -185,8 +202,8 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
   }
   put("axial_strain_at_first_break", first_break, "");
   put("broken_bonds_by_tenth_of_loading", at_tenth, "");
-  for (std::size_t k = 0; k < cycles.size(); ++k) {
-    const Cycle& c = cycles[k];
+  for (std::size_t k = 0; k < h.cycles.size(); ++k) {
+    const Cycle& c = h.cycles[k];
     const std::string n = "cycle" + std::to_string(k + 1) + "_";
     // The loading tangent just before the cycle, against the secant of the unloading: 1 for
     // an elastic cycle, below 1 as the loading carried plastic strain.
@@ -197,12 +214,23 @@ double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunCont
     put(n + "unloading_modulus_MPa", e_unload / 1e6, "MPa");
     put(n + "modulus_ratio", e_load / e_unload, "");
   }
-  const double mean_unbalanced = loading_records ? unbalanced_sum / loading_records : 0.0;
-  put("loading_steps", static_cast<double>(sim.steps() - start), "");
-  put("mean_unbalanced_force_ratio", mean_unbalanced, "");
-  if (strain_control) put("max_inertial_number", inertial_max, "");
+  put("loading_steps", static_cast<double>(h.steps), "");
+  put("mean_unbalanced_force_ratio", h.meanUnbalanced(), "");
+  if (strain_control) put("max_inertial_number", h.inertial_max, "");
+  return e0;
+}
 
-  warnIfNotQuasiStatic(sp, rec, stage, mean_unbalanced, strain_control ? inertial_max : 0.0);
+// The uniaxial-strain test of one branch (none, "virgin", "cored"); returns its initial
+// tangent modulus (Pa).
+template <int D>
+double loadOedometric(Specimen<D>& sp, const Settings& s, Recorder& rec, RunControl& control,
+                      const std::string& branch) {
+  const std::string stage = branch.empty() ? "loading" : branch;
+  const std::string prefix = branch.empty() ? "" : branch + ".";
+  const bool strain_control = s.control == Control::StrainRate;
+  const OedometricHistory h = loadUniaxially(sp, s, rec, control, stage, prefix);
+  const double e0 = recordOedometricResults(sp, h, strain_control, prefix, rec);
+  warnIfNotQuasiStatic(sp, rec, stage, h.meanUnbalanced(), strain_control ? h.inertial_max : 0.0);
   return e0;
 }
 

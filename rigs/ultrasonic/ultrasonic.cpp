@@ -193,99 +193,118 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-template <int D>
-StageResult measureStage(Specimen<D>& sp, const Settings& s, const std::string& stage, bool frames,
-                         Recorder& rec, RunControl& control) {
-  auto& sim = *sp.sim;
-  const std::uint64_t step = sim.steps();
-  const double time = sim.time();
-  recordState(sp, rec, "stage.", "loading", 0.0);
-  const double rho = bulkDensity(sp);
+// What a stage's measurement records: each value as a series at the stage's step, kept for
+// the results of the last stage.
+struct StageRecord {
+  Recorder& rec;
+  std::string stage;
+  std::uint64_t step;
+  double time;
   StageResult out;
-  auto put = [&](const std::string& name, double v) {
+  void put(const std::string& name, double v) {
     rec.series(name, step, time, v);
     out.values.emplace_back(name, v);
-  };
-  put("stage.density_kg_per_m3", rho);
+  }
+};
+
+// Figure 18's four waves through copies of the rested sample; returns each velocity found.
+template <int D>
+std::map<std::string, double> sendWaves(const Specimen<D>& rest, const Settings& s, bool frames,
+                                        StageRecord& r, RunControl& control) {
   std::map<std::string, double> v;
-  // The pulse goes through a copy at rest: the loading stopped and the walls held until the
-  // unbalanced force has died down. Mid-loading, bonds are still breaking; an avalanche in
-  // the window would drown the pulse, and would not repeat in the background copy.
-  control.tick(stage, step, -1.0, "holding a copy at rest");
-  Specimen<D> rest = sp.branch();
-  hold(rest, s, static_cast<std::uint64_t>(s.hold_steps));
   for (const WaveKind& k : figure18Waves<D>()) {
-    control.tick(stage, step, -1.0, std::string("wave ") + k.name);
+    control.tick(r.stage, r.step, -1.0, std::string("wave ") + k.name);
     Specimen<D> copy = rest.branch();
     WaveSpec spec = waveSpec(copy, s, k);
     spec.frames = frames ? s.frames : 0;
     const auto t0 = std::chrono::steady_clock::now();
     const WaveResult w = measureWave(*copy.sim, spec);
-    out.wave_seconds += secondsSince(t0);
-    ++out.pulses;
-    rec.wave(toRecord(w, k, stage, step, time));
+    r.out.wave_seconds += secondsSince(t0);
+    ++r.out.pulses;
+    r.rec.wave(toRecord(w, k, r.stage, r.step, r.time));
     for (std::size_t f = 0; f < w.frames.size(); ++f) {
-      rec.snapshot(std::string("wave-") + k.name,
-                   "wave front " + std::to_string(f + 1) + " of " + k.name, w.frames[f]);
+      r.rec.snapshot(std::string("wave-") + k.name,
+                     "wave front " + std::to_string(f + 1) + " of " + k.name, w.frames[f]);
     }
     const std::string base = std::string(k.type) == "P" ? std::string("vp_") + (k.name + 1)
                                                         : std::string("vs_") + (k.name + 1);
     if (!(w.xcorr.value > 0.0)) {
-      rec.message(step, time, "warning",
-                  stage + ": wave " + k.name +
-                      " gave no velocity (the arrivals did not grow "
-                      "later with distance); lower wave.frequency_kHz or move the receivers");
+      r.rec.message(r.step, r.time, "warning",
+                    r.stage + ": wave " + k.name +
+                        " gave no velocity (the arrivals did not grow "
+                        "later with distance); lower wave.frequency_kHz or move the receivers");
       continue;
     }
     v[base] = w.xcorr.value;
-    put(base, w.xcorr.value);
-    put(base + "_first_break", w.first_break.value);
-    put(base + "_error", w.xcorr.error);
-    out.min_wavelength_diameters =
-        std::min(out.min_wavelength_diameters, w.wavelength() / (2.0 * sp.mean_radius));
+    r.put(base, w.xcorr.value);
+    r.put(base + "_first_break", w.first_break.value);
+    r.put(base + "_error", w.xcorr.error);
+    r.out.min_wavelength_diameters =
+        std::min(r.out.min_wavelength_diameters, w.wavelength() / (2.0 * rest.mean_radius));
     if (std::isfinite(w.disagreement())) {
-      out.max_disagreement = std::max(out.max_disagreement, std::abs(w.disagreement()));
+      r.out.max_disagreement = std::max(r.out.max_disagreement, std::abs(w.disagreement()));
     }
   }
+  return v;
+}
+
+// The static constrained moduli along z and x from small strain cycles on copies.
+template <int D>
+void measureStatic(const Specimen<D>& rest, const Settings& s, StageRecord& r,
+                   RunControl& control) {
+  constexpr int z = D - 1;
+  for (const auto& [axis, name] : {std::pair{z, "modulus_z"}, std::pair{0, "modulus_x"}}) {
+    control.tick(r.stage, r.step, -1.0, std::string("static cycle ") + name);
+    const auto t0 = std::chrono::steady_clock::now();
+    const StaticModulus m = staticModulus(rest, s, axis);
+    r.out.static_seconds += secondsSince(t0);
+    ++r.out.cycles;
+    r.put(std::string(name) + "_static_MPa", m.unloading / 1e6);
+    r.put(std::string(name) + "_static_loading_MPa", m.loading / 1e6);
+  }
+}
+
+template <int D>
+StageResult measureStage(Specimen<D>& sp, const Settings& s, const std::string& stage, bool frames,
+                         Recorder& rec, RunControl& control) {
+  auto& sim = *sp.sim;
+  StageRecord r{rec, stage, sim.steps(), sim.time(), {}};
+  recordState(sp, rec, "stage.", "loading", 0.0);
+  const double rho = bulkDensity(sp);
+  r.put("stage.density_kg_per_m3", rho);
+  // The pulse goes through a copy at rest: the loading stopped and the walls held until the
+  // unbalanced force has died down. Mid-loading, bonds are still breaking; an avalanche in
+  // the window would drown the pulse, and would not repeat in the background copy.
+  control.tick(stage, r.step, -1.0, "holding a copy at rest");
+  Specimen<D> rest = sp.branch();
+  hold(rest, s, static_cast<std::uint64_t>(s.hold_steps));
+  std::map<std::string, double> v = sendWaves(rest, s, frames, r, control);
   // Dynamic moduli rho v^2 (Figure 18's velocities as stiffnesses): the P-wave (constrained)
   // moduli along and across the axis and the shear moduli of the two S waves.
   auto dynamic = [&](const std::string& vel, const std::string& name) {
-    if (v.count(vel)) put(name + "_dynamic_MPa", rho * v[vel] * v[vel] / 1e6);
+    if (v.count(vel)) r.put(name + "_dynamic_MPa", rho * v[vel] * v[vel] / 1e6);
   };
   dynamic("vp_z", "modulus_z");
   dynamic("vp_x", "modulus_x");
   dynamic("vs_zx", "shear_modulus_zx");
   dynamic("vs_xy", "shear_modulus_xy");
-  if (s.static_moduli) {
-    constexpr int z = D - 1;
-    for (const auto& [axis, name] : {std::pair{z, "modulus_z"}, std::pair{0, "modulus_x"}}) {
-      control.tick(stage, step, -1.0, std::string("static cycle ") + name);
-      const auto t0 = std::chrono::steady_clock::now();
-      const StaticModulus m = staticModulus(rest, s, axis);
-      out.static_seconds += secondsSince(t0);
-      ++out.cycles;
-      put(std::string(name) + "_static_MPa", m.unloading / 1e6);
-      put(std::string(name) + "_static_loading_MPa", m.loading / 1e6);
-    }
-  }
-  return out;
+  if (s.static_moduli) measureStatic(rest, s, r, control);
+  return r.out;
 }
 
+// Loads the formed specimen along the protocol's path and measures at each stage; the last
+// stage's wave fronts are kept as frames.
 template <int D>
-void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
+std::vector<StageResult> loadAndMeasure(Specimen<D>& sp, const Settings& s, Recorder& rec,
+                                        RunControl& control) {
   using Axis = typename LoadingFrame<D>::Axis;
   using Mode = typename LoadingFrame<D>::Mode;
   constexpr int ax = Specimen<D>::kAxial;
-  Specimen<D> sp = buildSpecimen<D>(s.specimen, control);
-  rec.result("particles", static_cast<double>(sp.sim->particles().size()), "");
-  formAndCement(sp, rec, control);
-  const auto record_every = static_cast<std::uint64_t>(s.specimen.output.record_every_steps);
   auto& frame = *sp.frame;
-  const double stress_rate = s.stress_rate;
+  const auto record_every = static_cast<std::uint64_t>(s.specimen.output.record_every_steps);
   std::vector<StageResult> stages;
-  std::size_t count = 0;
   auto measure = [&](bool last) {
-    const std::string stage = "stage " + std::to_string(++count);
+    const std::string stage = "stage " + std::to_string(stages.size() + 1);
     stages.push_back(measureStage(sp, s, stage, last, rec, control));
   };
   sp.resetBrokenCount();
@@ -293,35 +312,40 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   if (s.mode == LoadingMode::Hydrostatic) {
     const std::vector<double>& p = s.stages_stress;
     for (std::size_t k = 0; k < p.size(); ++k) {
-      servoTo(sp, p[k], p[k], stress_rate, "loading", rec, control);
+      servoTo(sp, p[k], p[k], s.stress_rate, "loading", rec, control);
       measure(k + 1 == p.size());
     }
+    return stages;
+  }
+  if (s.mode == LoadingMode::Triaxial) {
+    servoTo(sp, s.confining_stress, s.confining_stress, s.stress_rate, "confinement", rec, control);
+    frame.resetReference();
   } else {
-    if (s.mode == LoadingMode::Triaxial) {
-      const double sigma3 = s.confining_stress;
-      servoTo(sp, sigma3, sigma3, stress_rate, "confinement", rec, control);
-      frame.resetReference();
-    } else {
-      for (int a = 0; a < D; ++a) frame.set(a, Axis{});
+    for (int a = 0; a < D; ++a) frame.set(a, Axis{});
+  }
+  const double rate = s.axial_strain_rate;
+  frame.set(ax, Axis{Mode::StrainRate, rate});
+  const std::vector<double>& at = s.stages_axial_strain;
+  std::size_t next = 0;
+  while (next < at.size()) {
+    frame.step();
+    if (sp.sim->steps() % record_every == 0) recordState(sp, rec, "loading.", "loading", rate);
+    if (sp.sim->steps() % 200 == 0) {
+      control.tick("loading", sp.sim->steps(), frame.strain(ax) / at.back(),
+                   "axial stress " + fmt(frame.stress(ax) / 1e6) + " MPa");
     }
-    const double rate = s.axial_strain_rate;
-    frame.set(ax, Axis{Mode::StrainRate, rate});
-    const std::vector<double>& at = s.stages_axial_strain;
-    std::size_t next = 0;
-    while (next < at.size()) {
-      frame.step();
-      if (sp.sim->steps() % record_every == 0) recordState(sp, rec, "loading.", "loading", rate);
-      if (sp.sim->steps() % 200 == 0) {
-        control.tick("loading", sp.sim->steps(), frame.strain(ax) / at.back(),
-                     "axial stress " + fmt(frame.stress(ax) / 1e6) + " MPa");
-      }
-      if (frame.strain(ax) >= at[next]) {
-        ++next;
-        measure(next == at.size());
-      }
+    if (frame.strain(ax) >= at[next]) {
+      ++next;
+      measure(next == at.size());
     }
   }
-  snapshot(sp, rec, "loading", "final");
+  return stages;
+}
+
+// The last stage's values as results, the measurement's quality over every stage, and its
+// cost.
+template <int D>
+void recordStages(const Specimen<D>& sp, const std::vector<StageResult>& stages, Recorder& rec) {
   for (const auto& [name, value] : stages.back().values) rec.result(name, value, "");
   double min_wavelength = INFINITY, disagreement = 0.0;
   StageResult cost;
@@ -345,6 +369,16 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   recordTimings<D>(rec, {sp.sim.get()});
   rec.stageTiming("waves", cost.wave_seconds, cost.pulses);
   if (cost.cycles > 0) rec.stageTiming("static_cycles", cost.static_seconds, cost.cycles);
+}
+
+template <int D>
+void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
+  Specimen<D> sp = buildSpecimen<D>(s.specimen, control);
+  rec.result("particles", static_cast<double>(sp.sim->particles().size()), "");
+  formAndCement(sp, rec, control);
+  const std::vector<StageResult> stages = loadAndMeasure(sp, s, rec, control);
+  snapshot(sp, rec, "loading", "final");
+  recordStages(sp, stages, rec);
 }
 
 }  // namespace

@@ -372,7 +372,7 @@ TEST(Protocols, DisksUnderAStressRamp) {
   std::filesystem::remove(file);
 }
 
-// Simulate only what a scene calls for (DESIGN.md, principle 4): a dry, uncemented sample
+// Simulate only what a scene calls for (house rule 4, README.md): a dry, uncemented sample
 // runs contacts and nothing else, and a key for an effect its rig cannot use is refused
 // with the rig it belongs to.
 TEST(Protocols, ADryUncementedSceneRunsOnlyTheStagesItCallsFor) {

@@ -1,4 +1,4 @@
-// Observers never change the run (DESIGN.md rule 3): recording a specimen's state, its bond
+// Observers never change the run (house rule 3, README.md): recording a specimen's state, its bond
 // breaks and the fluid's readings twice, once or not at all leaves the same state, bit for
 // bit, and a break is recorded once however often the recorder looks.
 

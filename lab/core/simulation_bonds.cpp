@@ -1,0 +1,139 @@
+// Simulation: the bond stage. Cementing installs the parallel bonds; each step the bond pass
+// (bond_forces.hpp) adds their forces and records the bonds that broke, which are then logged
+// and removed in bond order (two-phase mutation, house rule 7 in README.md).
+
+#include "lab/core/simulation.hpp"
+
+#include <algorithm>
+
+#include "lab/core/stage_clock.hpp"
+
+namespace rocklab {
+
+template <int D>
+void Simulation<D>::computeBondForces(double dt) {
+  const StageClock clock(&stages_[kBonds]);
+  auto& P = particles_;
+  BondPass<D> pass{P,  bonds_, dt, threaded(),         config_.threads, config_.bond_breakage,
+                   {}, {},     {}, config_.bond_lanes, &bond_kinds_};
+  bond_forces_.compute(pass);
+  if (!pass.broken.empty()) {
+    // Second phase: log and remove the broken bonds in bond order.
+    std::vector<std::uint8_t> flag(bonds_.size(), 0);
+    for (std::size_t k = 0; k < pass.broken.size(); ++k) {
+      const std::uint32_t b = pass.broken[k];
+      const std::uint32_t i = bonds_.i[b], j = bonds_.j[b];
+      const auto section = BondSection<D>::of(bonds_.radius[b], P.thickness);
+      ledger_.bond_breakage += bondEnergy<D>(section, bonds_.kn[b], bonds_.ks[b], bonds_.load[b]);
+      const V d = P.pos[j] - P.pos[i];
+      const double dist = d.norm();
+      const double overlap = P.radius[i] + P.radius[j] - dist;
+      BondBreak<D> e;
+      e.step = step_;
+      e.time = time_;
+      e.position = P.pos[i] + (P.radius[i] - 0.5 * overlap) / dist * d;
+      e.mode = pass.modes[k];
+      e.a = P.id(i);
+      e.b = P.id(j);
+      e.kind = bonds_.kind[b];
+      e.stress = pass.stresses[k];
+      bond_breaks_.push_back(e);
+      ++broken_counts_[2 * e.kind + (e.mode == BondBreakMode::Shear ? 1 : 0)];
+      flag[b] = 1;
+    }
+    bonds_.removeFlagged(flag);
+    bond_forces_.invalidate();
+  }
+}
+
+template <int D>
+std::uint8_t Simulation<D>::addBondKind(BondKind kind) {
+  checkFields(kind, "bond kind '" + kind.name + "'");
+  if (bond_kinds_.size() >= 255) throw std::invalid_argument("at most 255 bond kinds");
+  bond_kinds_.push_back(std::move(kind));
+  broken_counts_.resize(2 * bond_kinds_.size(), 0);
+  return static_cast<std::uint8_t>(bond_kinds_.size() - 1);
+}
+
+template <int D>
+std::uint64_t Simulation<D>::brokenBonds(std::uint8_t kind, BondBreakMode mode) const {
+  return broken_counts_.at(2 * kind + (mode == BondBreakMode::Shear ? 1 : 0));
+}
+
+template <int D>
+CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
+  const BondKind& kind = bond_kinds_.at(kind_index);
+  requireRange("cementing", "gap_ratio", gap_ratio, 0.0, false, 1.0, false, "-");
+  auto& P = particles_;
+  CementReport report;
+  if (P.size() < 2) return report;
+  double rmax = 0.0;
+  for (double r : P.radius) rmax = std::max(rmax, r);
+  PairRows rows;
+  NeighborGrid<D> grid;
+  grid.build(P.pos, P.radius, gap_ratio * rmax, rows);
+
+  std::vector<std::uint64_t> existing;
+  for (std::size_t b = 0; b < bonds_.size(); ++b) {
+    existing.push_back(std::uint64_t{bonds_.i[b]} << 32 | bonds_.j[b]);
+  }
+  std::sort(existing.begin(), existing.end());
+  auto draw = [&](double mean, double sd, bool& skip) {
+    double s = rng_.normal(mean, sd);
+    while (s <= 0.0 && kind.negative == NegativeStrength::Resample) {
+      ++report.redrawn;
+      s = rng_.normal(mean, sd);
+    }
+    skip = skip || s <= 0.0;
+    return s;
+  };
+  for (std::uint32_t i = 0; i + 1 < rows.row.size(); ++i) {
+    for (std::uint32_t p = rows.row[i]; p < rows.row[i + 1]; ++p) {
+      const std::uint32_t j = rows.col[p];
+      const double gap = (P.pos[j] - P.pos[i]).norm() - P.radius[i] - P.radius[j];
+      const double rmin = std::min(P.radius[i], P.radius[j]);
+      if (gap >= gap_ratio * rmin) continue;
+      if (P.body[i] != kNoBody && P.body[i] == P.body[j]) continue;  // one rigid body
+      // Intragranular bonds join particles of one grain, intergranular bonds the others.
+      const bool same_grain = P.cluster[i] != kNoCluster && P.cluster[i] == P.cluster[j];
+      if (same_grain != kind.intragranular) continue;
+      ++report.candidates;
+      if (std::binary_search(existing.begin(), existing.end(), std::uint64_t{i} << 32 | j)) {
+        continue;
+      }
+      bool skip = false;
+      const double tensile = draw(kind.tensile_mean, kind.tensile_std, skip);
+      const double shear = draw(kind.shear_mean, kind.shear_std, skip);
+      if (skip) {
+        ++report.skipped_nonpositive;
+        continue;
+      }
+      bonds_.i.push_back(i);
+      bonds_.j.push_back(j);
+      bonds_.kind.push_back(kind_index);
+      bonds_.radius.push_back(kind.radius_multiplier * rmin);
+      // Stiffness per area from the bond modulus over the pair's length (PFC 5's linear
+      // parallel bond, deformability method: kn = E / L, L = r1 + r2).
+      const double kn = kind.modulus / (P.radius[i] + P.radius[j]);
+      bonds_.kn.push_back(kn);
+      bonds_.ks.push_back(kn / kind.stiffness_ratio);
+      bonds_.tensile.push_back(tensile);
+      bonds_.shear.push_back(shear);
+      bonds_.load.push_back(BondLoad<D>{});
+      ++report.installed;
+    }
+  }
+  bond_forces_.invalidate();
+  return report;
+}
+
+#define ROCKLAB_BOND_STAGE(D)                                                           \
+  template void Simulation<D>::computeBondForces(double);                               \
+  template std::uint8_t Simulation<D>::addBondKind(BondKind);                           \
+  template std::uint64_t Simulation<D>::brokenBonds(std::uint8_t, BondBreakMode) const; \
+  template CementReport Simulation<D>::cement(std::uint8_t, double);
+ROCKLAB_BOND_STAGE(2)
+ROCKLAB_BOND_STAGE(3)
+#undef ROCKLAB_BOND_STAGE
+
+}  // namespace rocklab
