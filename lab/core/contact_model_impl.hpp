@@ -296,9 +296,11 @@ class ContactModelImpl final : public ContactModel<D> {
           torque[k] -= c.f.torque_j;
         }
       }
-      // ... then the rows in order, as the serial pass.
+      // ... then the rows in order, as the serial pass. A thread may have no rows (the cost
+      // split gave them all to the others); its empty run starts at n, which need not be a
+      // block boundary, so it must not be rounded down into the last thread's block.
       std::size_t g = B.cross_start[t];
-      for (std::size_t b = lo / kBlockRows; b * kBlockRows < hi; ++b) {
+      for (std::size_t b = lo / kBlockRows; lo < hi && b * kBlockRows < hi; ++b) {
         ContactDissipation diss;
         bool over = false;
         std::uint32_t touching = 0;
