@@ -66,6 +66,25 @@ class NotebookRecorder : public rigs::Recorder {
   notebook::RunWriter& w_;
 };
 
+// `rocklab notebook delete`: without confirmation it only says what would go.
+int deleteRuns(notebook::Notebook& nb, const std::vector<std::int64_t>& runs, bool yes) {
+  for (std::int64_t run : runs) notebook::requireRun(nb, run);
+  for (std::int64_t run : runs) {
+    const auto row = notebook::query(
+        nb, "SELECT protocol, status, started FROM runs WHERE id = " + std::to_string(run));
+    const auto& r = row.rows.front();
+    std::cout << (yes ? "deleted" : "would delete") << " run " << run << " (" << r[0].str() << ", "
+              << r[1].str() << ", started " << r[2].str() << ") and " << nb.runFilesDir(run)
+              << "\n";
+    if (yes) nb.deleteRun(run);
+  }
+  if (!yes) {
+    std::cerr << "nothing deleted: add --yes to delete these runs and their files\n";
+    return 2;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int checkProtocol(const std::string& path) {
@@ -162,7 +181,12 @@ int notebookCommand(const NotebookOptions& o) {
     std::cerr << "no lab notebook at '" << o.lab << "' (rocklab run creates it; --lab PATH)\n";
     return 2;
   }
+  if (o.what == "sql") {
+    notebook::printTable(std::cout, notebook::readOnlyQuery(o.lab, o.sql), o.csv);
+    return 0;
+  }
   notebook::Notebook nb(o.lab);
+  if (o.what == "delete") return deleteRuns(nb, o.runs, o.yes);
   if (o.what == "runs") {
     notebook::printTable(std::cout, notebook::listRuns(nb), o.csv);
   } else if (o.what == "show") {
@@ -187,8 +211,6 @@ int notebookCommand(const NotebookOptions& o) {
     notebook::printTable(std::cout, notebook::seriesOf(nb, o.run, o.names), o.csv);
   } else if (o.what == "events") {
     notebook::printTable(std::cout, notebook::eventsOf(nb, o.run, o.kind), o.csv);
-  } else {
-    notebook::printTable(std::cout, notebook::query(nb, o.sql), o.csv);
   }
   return 0;
 }

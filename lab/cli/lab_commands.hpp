@@ -32,8 +32,10 @@ int listKeys(const std::string& rig);
 struct NotebookOptions {
   std::string lab = "lab.sqlite";
   bool csv = false;
-  std::string what;  // runs, show, series, events, sql
+  std::string what;  // runs, show, series, events, sql, delete
   std::int64_t run = 0;
+  std::vector<std::int64_t> runs;  // delete
+  bool yes = false;                // delete: confirmed
   std::vector<std::string> names;  // series names
   std::string kind;                // event kind
   std::string sql;

@@ -209,10 +209,15 @@ void addNotebook(CLI::App& app, Action& action) {
   ev->add_option("run", o->run, "Run id")->required();
   ev->add_option("--kind", o->kind, "Only events of this kind");
   ev->callback([o] { o->what = "events"; });
-  auto* sql = nbc->add_subcommand("sql", "Any SQL query");
+  auto* sql = nbc->add_subcommand(
+      "sql", "Any SQL query that reads (the notebook is opened read-only: writes are refused)");
   sql->add_option("query", o->sql, "SQL")->required();
   sql->callback([o] { o->what = "sql"; });
-  for (auto* sub : {show, ser, ev, sql, nbc->get_subcommand("runs")}) {
+  auto* del = nbc->add_subcommand("delete", "Remove runs: their rows in every table and files");
+  del->add_option("runs", o->runs, "Run ids")->required();
+  del->add_flag("--yes", o->yes, "Confirm (without it, only lists what would be removed)");
+  del->callback([o] { o->what = "delete"; });
+  for (auto* sub : {show, ser, ev, sql, del, nbc->get_subcommand("runs")}) {
     sub->add_option("--lab", o->lab, "Lab notebook (SQLite)");
     sub->add_flag("--csv", o->csv, "Print CSV");
   }

@@ -202,7 +202,8 @@ CREATE TABLE picks (
   return m;
 }
 
-Notebook::Notebook(const std::string& path) : db_(std::make_unique<Connection>(path, true)) {
+Notebook::Notebook(const std::string& path)
+    : db_(std::make_unique<Connection>(path, Access::Create)) {
   db_->exec("PRAGMA journal_mode = WAL");
   db_->exec("PRAGMA foreign_keys = ON");
   db_->exec("PRAGMA synchronous = NORMAL");
@@ -218,8 +219,27 @@ std::string Notebook::resolve(const std::string& relative) const {
   return (std::filesystem::path(path()).parent_path() / relative).string();
 }
 
+void Notebook::deleteRun(std::int64_t run) {
+  {
+    auto s = db_->prepare("SELECT status, host, pid FROM runs WHERE id = ?");
+    s.bind(1, run);
+    if (!s.step()) {
+      throw SqlError("no run " + std::to_string(run) + " in lab notebook '" + path() + "'");
+    }
+    if (s.text(0) == "running") {
+      throw SqlError("run " + std::to_string(run) + " is still running (pid " + s.text(2) + " on " +
+                     s.text(1) + "): stop it first");
+    }
+  }
+  Transaction t(*db_);
+  // Every other table's rows go with the run's (ON DELETE CASCADE, foreign_keys on).
+  db_->prepare("DELETE FROM runs WHERE id = ?").bind(1, run).run();
+  t.commit();
+  std::filesystem::remove_all(runFilesDir(run));
+}
+
 void Notebook::createAtVersion(const std::string& path, int version) {
-  Connection c(path, true);
+  Connection c(path, Access::Create);
   for (int v = 0; v < version; ++v) {
     c.exec(migrations()[v]);
     c.exec("PRAGMA user_version = " + std::to_string(v + 1));

@@ -29,6 +29,8 @@ class Notebook {
   // the notebook records them by paths relative to its own directory.
   std::string runFilesDir(std::int64_t run) const;
   std::string resolve(const std::string& relative) const;
+  // Removes a run: its rows in every table and its files. Refuses a run still running.
+  void deleteRun(std::int64_t run);
   // The schema migrations, in order; [k] takes version k to k + 1.
   static const std::vector<std::string_view>& migrations();
   // For tests: open a database and migrate it only up to `version`.

@@ -26,6 +26,13 @@ Table query(Notebook& nb, const std::string& sql) {
   return t;
 }
 
+Table readOnlyQuery(const std::string& lab, const std::string& sql) {
+  Connection c(lab, Access::ReadOnly);
+  Table t;
+  t.rows = c.query(sql, &t.columns);
+  return t;
+}
+
 void requireRun(Notebook& nb, std::int64_t run) {
   auto s = nb.db().prepare("SELECT 1 FROM runs WHERE id = ?");
   s.bind(1, run);

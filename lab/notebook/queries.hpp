@@ -15,6 +15,9 @@ struct Table {
 };
 
 Table query(Notebook& nb, const std::string& sql);
+// A query a user typed, on a read-only connection to the notebook file `lab`: a statement
+// that would change the notebook is refused before it runs (SqlError saying so).
+Table readOnlyQuery(const std::string& lab, const std::string& sql);
 Table listRuns(Notebook& nb);
 // The run's row, then its parameters, results, stage timings and record counts.
 std::vector<std::pair<std::string, Table>> showRun(Notebook& nb, std::int64_t run);

@@ -1,8 +1,10 @@
 #include "lab/notebook/sqlite.hpp"
 
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <sstream>
 
 namespace rocklab::notebook {
@@ -26,9 +28,18 @@ std::string Cell::str() const {
 }
 
 Statement::Statement(sqlite3* db, std::string_view sql) : db_(db) {
-  const int rc = sqlite3_prepare_v2(db_, sql.data(), static_cast<int>(sql.size()), &stmt_, nullptr);
+  const char* tail = nullptr;
+  const int rc = sqlite3_prepare_v2(db_, sql.data(), static_cast<int>(sql.size()), &stmt_, &tail);
   if (rc != SQLITE_OK) {
     throw SqlError(std::string(sqlite3_errmsg(db_)) + " in: " + std::string(sql));
+  }
+  // A second statement after the first would be ignored silently.
+  for (const char* c = tail; c && c < sql.data() + sql.size(); ++c) {
+    if (*c != ';' && !std::isspace(static_cast<unsigned char>(*c))) {
+      sqlite3_finalize(stmt_);
+      stmt_ = nullptr;
+      throw SqlError("one statement at a time, not: " + std::string(sql));
+    }
   }
 }
 
@@ -134,8 +145,43 @@ Cell Statement::cell(int c) const {
   return x;
 }
 
-Connection::Connection(const std::string& path, bool create) : path_(path) {
-  const int flags = SQLITE_OPEN_READWRITE | (create ? SQLITE_OPEN_CREATE : 0);
+namespace {
+
+// The pragmas that only read, with or without an argument naming a table or index.
+bool pragmaReads(const char* name, const char* argument) {
+  static const char* const introspection[] = {
+      "table_info",     "table_xinfo",      "table_list",      "index_list",  "index_info",
+      "index_xinfo",    "foreign_key_list", "integrity_check", "quick_check", "database_list",
+      "collation_list", "function_list",    "module_list",     "pragma_list", "compile_options"};
+  for (const char* p : introspection) {
+    if (sqlite3_stricmp(name, p) == 0) return true;
+  }
+  return argument == nullptr;  // `PRAGMA user_version` reads; `PRAGMA user_version = 3` writes
+}
+
+// The authorizer of a read-only connection (sqlite.org/c3ref/set_authorizer.html): denies
+// what the READONLY open flag lets through, since ATTACH and DETACH change the connection
+// rather than the file and some pragmas write before the flag is consulted.
+extern "C" int denyChanges(void*, int action, const char* a1, const char* a2, const char*,
+                           const char*) {
+  switch (action) {
+    case SQLITE_ATTACH:
+    case SQLITE_DETACH:
+      return SQLITE_DENY;
+    case SQLITE_PRAGMA:
+      return pragmaReads(a1, a2) ? SQLITE_OK : SQLITE_DENY;
+    default:
+      return SQLITE_OK;
+  }
+}
+
+}  // namespace
+
+Connection::Connection(const std::string& path, Access access)
+    : path_(path), read_only_(access == Access::ReadOnly) {
+  const int flags = access == Access::ReadOnly ? SQLITE_OPEN_READONLY
+                    : access == Access::Create ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE
+                                               : SQLITE_OPEN_READWRITE;
   if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
     const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
@@ -143,6 +189,7 @@ Connection::Connection(const std::string& path, bool create) : path_(path) {
     throw SqlError("cannot open lab notebook '" + path + "': " + why);
   }
   sqlite3_busy_timeout(db_, 10000);  // another writer (a second run in the same lab) waits
+  if (read_only_) sqlite3_set_authorizer(db_, denyChanges, nullptr);
 }
 
 Connection::~Connection() {
@@ -167,7 +214,18 @@ int Connection::userVersion() {
 
 std::vector<std::vector<Cell>> Connection::query(std::string_view sql,
                                                  std::vector<std::string>* names) {
-  Statement s(db_, sql);
+  const std::string refused = "the lab notebook '" + path_ +
+                              "' is open read-only here: this statement would change it (runs "
+                              "are removed with `rocklab notebook delete RUN --yes`)";
+  std::optional<Statement> prepared;
+  try {
+    prepared.emplace(db_, sql);
+  } catch (const SqlError&) {
+    if (read_only_ && sqlite3_errcode(db_) == SQLITE_AUTH) throw SqlError(refused);
+    throw;
+  }
+  Statement& s = *prepared;
+  if (read_only_ && !s.readOnly()) throw SqlError(refused);
   if (names) {
     names->clear();
     for (int c = 0; c < s.columns(); ++c) names->push_back(s.columnName(c));

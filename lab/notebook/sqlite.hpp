@@ -51,6 +51,7 @@ class Statement {
 
   // Steps once; true while a row is available.
   bool step();
+  bool readOnly() const { return sqlite3_stmt_readonly(stmt_) != 0; }
   // Runs to completion and resets, ready for new binds.
   void run();
   void reset();
@@ -70,10 +71,14 @@ class Statement {
   sqlite3_stmt* stmt_ = nullptr;
 };
 
+// How a connection may touch its file. ReadOnly refuses, before anything runs, every
+// statement that would change the file or the connection (ATTACH, DETACH, a PRAGMA that
+// sets something): what a user types into `rocklab notebook sql` cannot lose the lab.
+enum class Access { ReadOnly, ReadWrite, Create };
+
 class Connection {
  public:
-  // Opens (and with `create`, creates) the database file.
-  Connection(const std::string& path, bool create);
+  Connection(const std::string& path, Access access);
   ~Connection();
   Connection(const Connection&) = delete;
   Connection& operator=(const Connection&) = delete;
@@ -83,6 +88,7 @@ class Connection {
   std::int64_t lastInsertId() const { return sqlite3_last_insert_rowid(db_); }
   int userVersion();
   const std::string& path() const { return path_; }
+  bool readOnly() const { return read_only_; }
 
   // All rows of a query, with the column names first.
   std::vector<std::vector<Cell>> query(std::string_view sql, std::vector<std::string>* names);
@@ -90,6 +96,7 @@ class Connection {
  private:
   sqlite3* db_ = nullptr;
   std::string path_;
+  bool read_only_ = false;
 };
 
 // A transaction that rolls back unless committed.

@@ -560,8 +560,23 @@ TEST(Protocols, NotebookCommandsQueryTheLab) {
                 "notebook sql \"SELECT count(*) AS n FROM runs\" --lab " + lab.path, &out),
             0);
   EXPECT_EQ(out, "n\n1\n");
+  EXPECT_NE(
+      rocklab::testing::runRocklab("notebook sql \"DROP TABLE runs\" --lab " + lab.path, &out), 0);
+  EXPECT_NE(out.find("read-only"), std::string::npos) << out;
   EXPECT_NE(rocklab::testing::runRocklab("notebook show 7 --lab " + lab.path, &out), 0);
   EXPECT_NE(out.find("no run 7"), std::string::npos) << out;
+  // Deleting asks for confirmation, then removes the run's rows and files together.
+  EXPECT_EQ(rocklab::testing::runRocklab("notebook delete 1 --lab " + lab.path, &out), 2);
+  EXPECT_NE(out.find("add --yes"), std::string::npos) << out;
+  EXPECT_EQ(rocklab::testing::runRocklab("notebook runs --csv --lab " + lab.path, &out), 0);
+  EXPECT_NE(out.find("hydrostatic-quick"), std::string::npos) << out;
+  EXPECT_EQ(rocklab::testing::runRocklab("notebook delete 1 --yes --lab " + lab.path, &out), 0)
+      << out;
+  EXPECT_FALSE(std::filesystem::exists(lab.path + ".files/run-1"));
+  EXPECT_EQ(rocklab::testing::runRocklab(
+                "notebook sql \"SELECT count(*) AS n FROM series\" --lab " + lab.path, &out),
+            0);
+  EXPECT_EQ(out, "n\n0\n");
 }
 
 }  // namespace

@@ -186,7 +186,7 @@ TEST_F(NotebookTest, LargeRunsAreWrittenInBatchesWhileRunning) {
 TEST_F(NotebookTest, OldSchemaIsMigratedAndNewerRefused) {
   Notebook::createAtVersion(path_, 1);
   {
-    Connection c(path_, false);
+    Connection c(path_, Access::ReadWrite);
     c.exec(
         "INSERT INTO runs (protocol, protocol_file, protocol_text, protocol_hash, rig, status, "
         "started, code_version, build_type, host, pid) VALUES ('p', 'f', 't', 'h', 'oedometer', "
@@ -200,7 +200,7 @@ TEST_F(NotebookTest, OldSchemaIsMigratedAndNewerRefused) {
     EXPECT_EQ(scalar(nb, "SELECT count(*) FROM events WHERE stage IS NULL"), "0");
   }
   {
-    Connection c(path_, false);
+    Connection c(path_, Access::ReadWrite);
     c.exec("PRAGMA user_version = 99");
   }
   try {
@@ -235,6 +235,82 @@ TEST_F(NotebookTest, TablesPrintAlignedAndAsCsv) {
   EXPECT_EQ(csv.str(), "a,b,c,d\n1,\"x, \"\"y\"\"\",2.5,\n");
   EXPECT_NE(text.str().find("a  b"), std::string::npos) << text.str();
   EXPECT_THROW(showRun(nb, 42), SqlError);
+}
+
+// A finished run with a row in every table that hangs off runs, and a file beside the lab.
+std::int64_t recordFullRun(Notebook& nb, const RunInfo& info) {
+  RunWriter w(nb, info, {{"protocol.seed", "7", ""}});
+  w.series("axial_stress_MPa", 0, 0.0, 1.0);
+  EventRecord e;
+  e.kind = "bond_break";
+  w.event(e);
+  w.result("peak", 1, "MPa");
+  w.stageTiming("contacts", 1.0, 1);
+  w.message(0, 0.0, "info", "hello");
+  w.snapshot("frame", "loading", "final", 1, 0.1, "bytes", "rkf");
+  w.finish(RunStatus::Completed);
+  return w.id();
+}
+
+TEST_F(NotebookTest, TypedSqlIsReadOnly) {
+  std::int64_t id;
+  {
+    Notebook nb(path_);
+    id = recordFullRun(nb, info());
+  }
+  EXPECT_EQ(readOnlyQuery(path_, "SELECT count(*) FROM runs").rows[0][0].str(), "1");
+  EXPECT_FALSE(readOnlyQuery(path_, "PRAGMA table_info(runs)").rows.empty());
+  EXPECT_EQ(readOnlyQuery(path_, "PRAGMA user_version").rows[0][0].str(),
+            std::to_string(kSchemaVersion));
+  const std::string other = path_ + ".other";
+  for (const std::string& sql :
+       {std::string("DROP TABLE runs"), std::string("DELETE FROM series"),
+        std::string("UPDATE runs SET status = 'failed'"),
+        std::string("INSERT INTO runs (id) VALUES (9)"), "ATTACH DATABASE '" + other + "' AS o",
+        std::string("PRAGMA user_version = 3"), std::string("PRAGMA journal_mode = DELETE"),
+        std::string("VACUUM"), std::string("SELECT 1; DROP TABLE runs"),
+        std::string("CREATE TABLE t (x)")}) {
+    try {
+      readOnlyQuery(path_, sql);
+      ADD_FAILURE() << "not refused: " << sql;
+    } catch (const SqlError& e) {
+      const std::string why = e.what();
+      EXPECT_TRUE(why.find("read-only") != std::string::npos ||
+                  why.find("one statement at a time") != std::string::npos)
+          << sql << ": " << why;
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(other));
+  Notebook nb(path_);
+  EXPECT_EQ(nb.db().userVersion(), kSchemaVersion);
+  EXPECT_EQ(scalar(nb, "PRAGMA journal_mode"), "wal");
+  EXPECT_EQ(scalar(nb, "SELECT status FROM runs WHERE id = " + std::to_string(id)), "completed");
+  EXPECT_EQ(scalar(nb, "SELECT count(*) FROM series"), "1");
+}
+
+TEST_F(NotebookTest, DeletingARunRemovesItsRowsAndFiles) {
+  Notebook nb(path_);
+  const std::int64_t gone = recordFullRun(nb, info());
+  const std::int64_t kept = recordFullRun(nb, info());
+  ASSERT_TRUE(std::filesystem::exists(nb.runFilesDir(gone)));
+  nb.deleteRun(gone);
+  EXPECT_FALSE(std::filesystem::exists(nb.runFilesDir(gone)));
+  EXPECT_TRUE(std::filesystem::exists(nb.runFilesDir(kept)));
+  for (const char* table :
+       {"params", "series", "events", "results", "stage_timings", "messages", "snapshots"}) {
+    EXPECT_EQ(scalar(nb, std::string("SELECT count(*) FROM ") + table +
+                             " WHERE run_id = " + std::to_string(gone)),
+              "0")
+        << table;
+    EXPECT_EQ(scalar(nb, std::string("SELECT count(*) FROM ") + table +
+                             " WHERE run_id = " + std::to_string(kept)),
+              "1")
+        << table;
+  }
+  EXPECT_THROW(nb.deleteRun(gone), SqlError);
+  RunWriter live(nb, info(), {});
+  EXPECT_THROW(nb.deleteRun(live.id()), SqlError);
+  std::filesystem::remove_all(path_ + ".files");
 }
 
 }  // namespace
