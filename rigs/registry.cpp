@@ -88,10 +88,20 @@ void checkKeyResults(const RigEntry& rig, const protocol::Settings& s) {
 
 }  // namespace
 
-CheckedProtocol checkProtocol(const std::string& path) {
-  const std::string text = protocol::readFile(path);
-  const RigEntry& rig = findRig(protocol::rigOf(path, text), path);
-  CheckedProtocol c{&rig, protocol::parseProtocol(path, text, schemaOf(rig))};
+CheckedProtocol checkProtocol(const std::string& path,
+                              const std::vector<protocol::Override>& overrides) {
+  return checkProtocolText(path, protocol::readFile(path), overrides);
+}
+
+CheckedProtocol checkProtocolText(const std::string& path, const std::string& text,
+                                  const std::vector<protocol::Override>& overrides) {
+  std::string rig_name;
+  for (const auto& o : overrides) {
+    if (o.key == "protocol.rig") rig_name = o.value;  // the schema depends on it
+  }
+  if (rig_name.empty()) rig_name = protocol::rigOf(path, text);
+  const RigEntry& rig = findRig(rig_name, path);
+  CheckedProtocol c{&rig, protocol::parseProtocol(path, text, schemaOf(rig), overrides)};
   validateProtocol(rig, c.settings);
   return c;
 }

@@ -46,7 +46,13 @@ struct CheckedProtocol {
   const RigEntry* rig;
   protocol::Settings settings;
 };
-CheckedProtocol checkProtocol(const std::string& path);
+// Overrides (`--set KEY=VALUE`) are checked with the file's keys, as if the file gave them.
+CheckedProtocol checkProtocol(const std::string& path,
+                              const std::vector<protocol::Override>& overrides = {});
+// The same for a protocol's text kept elsewhere (the notebook's, for `rocklab rerun`),
+// read as if it were the file `path`.
+CheckedProtocol checkProtocolText(const std::string& path, const std::string& text,
+                                  const std::vector<protocol::Override>& overrides = {});
 // The checks across keys again, after values were replaced (a study's settings).
 void validateProtocol(const RigEntry& rig, const protocol::Settings& s);
 

@@ -87,9 +87,15 @@ int deleteRuns(notebook::Notebook& nb, const std::vector<std::int64_t>& runs, bo
 
 }  // namespace
 
-int checkProtocol(const std::string& path) {
+std::vector<protocol::Override> overridesOf(const std::vector<std::string>& sets) {
+  std::vector<protocol::Override> o;
+  for (const std::string& s : sets) o.push_back(protocol::parseOverride(s));
+  return o;
+}
+
+int checkProtocol(const std::string& path, const std::vector<std::string>& sets) {
   try {
-    const auto c = rigs::checkProtocol(path);
+    const auto c = rigs::checkProtocol(path, overridesOf(sets));
     std::size_t given = 0, total = 0;
     for (const auto& row : c.settings.table()) {
       ++total;
@@ -123,7 +129,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
   notebook::RunInfo info;
   info.protocol = settings.text("protocol.name");
   info.protocol_file = std::filesystem::absolute(protocol_file).string();
-  info.protocol_text = settings.source();
+  info.protocol_text = settings.effectiveText();
   info.rig = std::string(rig.name);
   info.code_version = kGitRevision;
   info.build_type = kBuildType;
@@ -166,7 +172,7 @@ int runProtocol(const RunOptions& o) {
   // protocol writes nothing.
   rigs::CheckedProtocol c{nullptr, {}};
   try {
-    c = rigs::checkProtocol(o.protocol);
+    c = rigs::checkProtocol(o.protocol, overridesOf(o.sets));
   } catch (const protocol::ProtocolError& e) {
     std::cerr << e.what() << "\n";
     return 2;
@@ -174,6 +180,38 @@ int runProtocol(const RunOptions& o) {
   protocol::Settings settings = c.settings;
   if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
   return runSettings(*c.rig, settings, o.protocol, o.lab, o.quiet).code;
+}
+
+int rerunProtocol(std::int64_t run, const RunOptions& o) {
+  if (!std::filesystem::exists(o.lab)) {
+    std::cerr << "no lab notebook at '" << o.lab << "' (--lab PATH)\n";
+    return 2;
+  }
+  std::string file, text, version;
+  {
+    notebook::Notebook nb(o.lab);
+    notebook::requireRun(nb, run);
+    auto s =
+        nb.db().prepare("SELECT protocol_file, protocol_text, code_version FROM runs WHERE id = ?");
+    s.bind(1, run);
+    s.step();
+    file = s.text(0), text = s.text(1), version = s.text(2);
+  }
+  if (version != kGitRevision) {
+    std::cerr << "warning: run " << run << " was made by rocklab " << version << ", this is "
+              << kGitRevision << ": results may differ where the code changed\n";
+  }
+  rigs::CheckedProtocol c{nullptr, {}};
+  try {
+    c = rigs::checkProtocolText(file, text, overridesOf(o.sets));
+  } catch (const protocol::ProtocolError& e) {
+    std::cerr << "run " << run << "'s protocol (" << file << "):\n" << e.what() << "\n";
+    return 2;
+  }
+  protocol::Settings settings = c.settings;
+  if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+  std::cerr << "rerun of run " << run << "\n";
+  return runSettings(*c.rig, settings, file, o.lab, o.quiet).code;
 }
 
 int notebookCommand(const NotebookOptions& o) {

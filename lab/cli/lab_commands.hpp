@@ -13,12 +13,18 @@ struct RunOptions {
   std::string protocol;
   std::string lab = "lab.sqlite";
   bool quiet = false;
-  int threads = 0;  // 0: as the protocol says
+  int threads = 0;                // 0: as the protocol says
+  std::vector<std::string> sets;  // "KEY=VALUE" from --set, in order
 };
 
 // Returns the process exit code: 0 completed, 1 failed, 2 invalid protocol, 130 interrupted.
 int runProtocol(const RunOptions& o);
-int checkProtocol(const std::string& path);
+int checkProtocol(const std::string& path, const std::vector<std::string>& sets);
+// `rocklab rerun`: a run of the notebook run again from its effective protocol text alone,
+// into the same notebook as a new run.
+int rerunProtocol(std::int64_t run, const RunOptions& o);
+// The --set arguments as overrides; throws protocol::ProtocolError for one without '='.
+std::vector<protocol::Override> overridesOf(const std::vector<std::string>& sets);
 
 struct RunOutcome {
   int code = 0;  // as runProtocol's

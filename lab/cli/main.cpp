@@ -164,6 +164,15 @@ void addBench(CLI::App& app, Action& action) {
   b->callback([&action, o, json] { action = [o, json] { return runBenchCommand(*o, *json); }; });
 }
 
+void addSet(CLI::App* command, std::vector<std::string>& sets) {
+  command
+      ->add_option("--set", sets,
+                   "KEY=VALUE: a protocol key's value instead of the file's (repeatable); "
+                   "checked like the file's keys, kept in the notebook's protocol text")
+      ->take_all()
+      ->allow_extra_args(false);
+}
+
 void addRun(CLI::App& app, Action& action) {
   auto o = std::make_shared<rocklab::cli::RunOptions>();
   auto* r = app.add_subcommand("run", "Run a protocol; every measurement goes to the lab notebook");
@@ -174,14 +183,32 @@ void addRun(CLI::App& app, Action& action) {
   r->add_flag("--quiet", o->quiet, "No progress on stderr");
   r->add_option("--threads", o->threads, "Threads, instead of numerics.threads (same results)")
       ->check(CLI::Range(1, 1024));
+  addSet(r, o->sets);
   r->callback([&action, o] { action = [o] { return rocklab::cli::runProtocol(*o); }; });
+
+  auto ro = std::make_shared<rocklab::cli::RunOptions>();
+  auto run = std::make_shared<std::int64_t>(0);
+  auto* rr = app.add_subcommand(
+      "rerun", "Run a run of the notebook again, from the protocol text the notebook kept");
+  rr->add_option("run", *run, "Run id")->required();
+  rr->add_option("--lab", ro->lab, "Lab notebook (SQLite); the new run goes there too");
+  rr->add_flag("--quiet", ro->quiet, "No progress on stderr");
+  rr->add_option("--threads", ro->threads, "Threads (same results)")->check(CLI::Range(1, 1024));
+  addSet(rr, ro->sets);
+  rr->callback([&action, ro, run] {
+    action = [ro, run] { return rocklab::cli::rerunProtocol(*run, *ro); };
+  });
 }
 
 void addCheckAndKeys(CLI::App& app, Action& action) {
   auto file = std::make_shared<std::string>();
+  auto sets = std::make_shared<std::vector<std::string>>();
   auto* c = app.add_subcommand("check", "Validate a protocol without running it");
   c->add_option("protocol", *file, "Protocol file (TOML)")->required();
-  c->callback([&action, file] { action = [file] { return rocklab::cli::checkProtocol(*file); }; });
+  addSet(c, *sets);
+  c->callback([&action, file, sets] {
+    action = [file, sets] { return rocklab::cli::checkProtocol(*file, *sets); };
+  });
 
   auto rig = std::make_shared<std::string>();
   auto* k = app.add_subcommand(
@@ -281,6 +308,7 @@ void addStudy(CLI::App& app, Action& action) {
       ->required()
       ->allow_extra_args(false);
   acc->add_option("--lab", o->lab, "Lab notebook (SQLite), created if missing");
+  addSet(acc, o->sets);
   acc->add_option("--out", o->out, "Output folder of the study report")->required();
   acc->add_option("--tolerance", o->tolerance_percent,
                   "Largest deviation of a key result accepted (%), to name the cheapest setting")

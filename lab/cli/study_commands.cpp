@@ -136,7 +136,7 @@ int studyAccuracy(const StudyOptions& o) {
   std::vector<protocol::Settings> runs;
   std::vector<std::string> labels;
   try {
-    c = rigs::checkProtocol(o.protocol);
+    c = rigs::checkProtocol(o.protocol, overridesOf(o.sets));
     if (c.settings.texts("protocol.key_results").empty()) {
       protocol::fail(c.settings, "protocol.key_results",
                      "the protocol names no key results: a study has nothing to compare "
@@ -160,12 +160,7 @@ int studyAccuracy(const StudyOptions& o) {
     for (const auto& combo : combinations(ladders)) {
       protocol::Settings s = c.settings;
       for (const auto& [key, value] : combo) {
-        if (!s.declared(key)) {
-          throw protocol::ProtocolError({"--vary " + key + ": not a key of " +
-                                         std::string(c.rig->name) + " protocols (`rocklab keys " +
-                                         std::string(c.rig->name) + "`)"});
-        }
-        s.overrideText(key, value);
+        s.apply({{key, value, "--vary"}});
       }
       if (o.threads > 0) s.override("numerics.threads", static_cast<std::int64_t>(o.threads));
       rigs::validateProtocol(*c.rig, s);

@@ -12,6 +12,7 @@ namespace rocklab::cli {
 struct StudyOptions {
   std::string protocol;
   std::vector<std::string> vary;  // "KEY=v1,v2,...", the finest value first
+  std::vector<std::string> sets;  // "KEY=VALUE" from --set, for every setting
   std::string lab = "lab.sqlite";
   std::string out;
   double tolerance_percent = 5.0;

@@ -1,10 +1,13 @@
 #include "lab/protocol/params.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <toml.hpp>
+#include <tuple>
 
 namespace rocklab::protocol {
 
@@ -164,6 +167,7 @@ const std::vector<std::string>& Settings::texts(const std::string& key) const {
 }
 
 std::string Settings::where(const std::string& key) const {
+  if (auto o = overrides_.find(key); o != overrides_.end()) return o->second.label();
   auto it = given_.find(key);
   return file_ + (it == given_.end() ? "" : ":" + std::to_string(it->second));
 }
@@ -190,49 +194,6 @@ void Settings::override(const std::string& key, Value v) {
 
 bool Settings::declared(const std::string& key) const {
   return schema_ && schema_->find(key);
-}
-
-void Settings::overrideText(const std::string& key, const std::string& text) {
-  const ParamDecl* d = schema_ ? schema_->find(key) : nullptr;
-  if (!d) throw ProtocolError({"'" + key + "' is not a key of this protocol's rig"});
-  auto bad = [&](const std::string& expect) {
-    return ProtocolError({key + " = " + text + ": expects " + expect + unitText(*d)});
-  };
-  std::size_t used = 0;
-  try {
-    switch (d->kind) {
-      case Kind::Real: {
-        const double v = std::stod(text, &used);
-        if (used != text.size()) throw bad("a number");
-        override(key, v);
-        return;
-      }
-      case Kind::Integer: {
-        const long long v = std::stoll(text, &used);
-        if (used != text.size()) throw bad("an integer");
-        override(key, static_cast<std::int64_t>(v));
-        return;
-      }
-      case Kind::Choice:
-        if (std::find(d->choices.begin(), d->choices.end(), text) == d->choices.end())
-          throw bad(d->rangeText());
-        [[fallthrough]];
-      case Kind::Text:
-        override(key, text);
-        return;
-      case Kind::Flag:
-        if (text != "true" && text != "false") throw bad("true or false");
-        override(key, text == "true");
-        return;
-      case Kind::RealList:
-      case Kind::TextList:
-        throw bad("one value: a list key cannot be varied from the command line");
-    }
-  } catch (const std::invalid_argument&) {
-    throw bad(d->kind == Kind::Real ? "a number" : "an integer");
-  } catch (const std::out_of_range&) {
-    throw bad("a value in " + d->rangeText());
-  }
 }
 
 void fail(const Settings& s, const std::string& key, const std::string& why) {
@@ -273,12 +234,18 @@ std::string rigOf(const std::string& file, const std::string& text) {
 
 namespace {
 
-// The problems found in a protocol file, each at its line, reported in line order.
+// Where a value was given: a line of the file, or an override on the command line.
+struct Place {
+  int order;         // problems are reported in this order: the file's lines, then overrides
+  std::string text;  // "p.toml:12", "--set loading.rate_per_s=3"
+};
+
+// The problems found in a protocol, each at its place, reported in order.
 class Problems {
  public:
   explicit Problems(std::string file) : file_(std::move(file)) {}
-  void at(int line, const std::string& what) {
-    list_.emplace_back(line, file_ + ":" + std::to_string(line) + ": " + what);
+  void at(const Place& place, const std::string& what) {
+    list_.emplace_back(place.order, place.text + ": " + what);
   }
   void unplaced(const std::string& what) { list_.emplace_back(1 << 30, file_ + ": " + what); }
   void throwIfAny() {
@@ -297,7 +264,7 @@ class Problems {
 
 // The declaration of a key the file gives, or nullptr with the problem noted: a key of
 // another rig, or an unknown key with the nearest known one.
-const ParamDecl* declarationOf(const Schema& schema, const std::string& key, int line,
+const ParamDecl* declarationOf(const Schema& schema, const std::string& key, const Place& line,
                                Problems& problems) {
   if (const ParamDecl* d = schema.find(key)) return d;
   if (!schema.foreignRigs(key).empty()) {
@@ -321,7 +288,8 @@ const ParamDecl* declarationOf(const Schema& schema, const std::string& key, int
 
 // A TOML value as the declared kind, its range and choices checked; none (the problem
 // noted) when it is not of that kind.
-std::optional<Value> valueOf(const ParamDecl& d, const TomlValue& v, int line, Problems& problems) {
+std::optional<Value> valueOf(const ParamDecl& d, const TomlValue& v, const Place& line,
+                             Problems& problems) {
   const std::string expect = "'" + d.key + "'" + unitText(d) + " expects ";
   auto checkRange = [&](double x) {
     if (!inRange(d, x)) {
@@ -390,9 +358,74 @@ std::optional<Value> valueOf(const ParamDecl& d, const TomlValue& v, int line, P
   return std::nullopt;
 }
 
+// An override's value as TOML; bare text for a text key when it is not a TOML string.
+std::optional<TomlValue> overrideValue(const ParamDecl& d, const Override& o, const Place& place,
+                                       Problems& problems) {
+  const bool text = d.kind == Kind::Text || d.kind == Kind::Choice;
+  try {
+    std::istringstream in("v = " + o.value);
+    const TomlValue v =
+        toml::parse<toml::discard_comments, std::map, std::vector>(in, o.origin).at("v");
+    if (!text || v.is_string()) return v;
+  } catch (const std::exception&) {
+    if (!text) {
+      problems.at(place, "'" + o.value +
+                             "' is not a value (a number, true or false, a list in [], "
+                             "or text)");
+      return std::nullopt;
+    }
+  }
+  return TomlValue(o.value);
+}
+
+// Validates overrides into `values`, like keys of the file.
+void applyOverrides(const Schema& schema, const std::vector<Override>& overrides,
+                    std::map<std::string, Value>& values, std::map<std::string, int>& given,
+                    std::map<std::string, Override>& applied, Problems& problems) {
+  for (std::size_t k = 0; k < overrides.size(); ++k) {
+    const Override& o = overrides[k];
+    const Place place{(1 << 29) + static_cast<int>(k), o.label()};
+    const ParamDecl* d = declarationOf(schema, o.key, place, problems);
+    if (!d) continue;
+    const auto v = overrideValue(*d, o, place, problems);
+    if (!v) continue;
+    if (auto value = valueOf(*d, *v, place, problems)) {
+      values[o.key] = std::move(*value);
+      given.try_emplace(o.key, 0);
+      applied[o.key] = o;
+    }
+  }
+}
+
 }  // namespace
 
-Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema) {
+Override parseOverride(const std::string& text, const std::string& origin) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw ProtocolError({origin + " " + text + ": expects KEY=VALUE, e.g. " + origin +
+                         " loading.confining_stress_MPa=10"});
+  }
+  auto trim = [](std::string t) {
+    const auto a = t.find_first_not_of(" \t"), b = t.find_last_not_of(" \t");
+    return a == std::string::npos ? std::string() : t.substr(a, b - a + 1);
+  };
+  return {trim(text.substr(0, eq)), trim(text.substr(eq + 1)), origin};
+}
+
+void Settings::apply(const std::vector<Override>& overrides) {
+  Problems problems(file_);
+  std::map<std::string, Value> values = values_;
+  std::map<std::string, int> given = given_;
+  std::map<std::string, Override> applied = overrides_;
+  applyOverrides(*schema_, overrides, values, given, applied, problems);
+  problems.throwIfAny();
+  values_ = std::move(values);
+  given_ = std::move(given);
+  overrides_ = std::move(applied);
+}
+
+Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema,
+                       const std::vector<Override>& overrides) {
   const TomlValue root = parseToml(file, text);
   Settings s;
   s.schema_ = std::make_shared<const Schema>(schema);
@@ -407,13 +440,15 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
         self(self, v, key);
         continue;
       }
-      const ParamDecl* d = declarationOf(schema, key, line, problems);
+      const Place place{line, file + ":" + std::to_string(line)};
+      const ParamDecl* d = declarationOf(schema, key, place, problems);
       if (!d) continue;
       s.given_[key] = line;
-      if (auto value = valueOf(*d, v, line, problems)) s.values_[key] = std::move(*value);
+      if (auto value = valueOf(*d, v, place, problems)) s.values_[key] = std::move(*value);
     }
   };
   walk(walk, root, "");
+  applyOverrides(schema, overrides, s.values_, s.given_, s.overrides_, problems);
   for (const ParamDecl& d : schema.all()) {
     if (s.given_.count(d.key)) continue;
     if (d.fallback) {
@@ -424,6 +459,161 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
   }
   problems.throwIfAny();
   return s;
+}
+
+namespace {
+
+// A value written as TOML that reads back to the same bits: numbers by the shortest
+// round-trip form (std::to_chars), texts quoted.
+std::string tomlLiteral(const Value& v) {
+  auto real = [](double x) {
+    if (std::isinf(x)) return std::string(x > 0 ? "inf" : "-inf");
+    if (std::isnan(x)) return std::string("nan");
+    char buf[32];
+    const auto end = std::to_chars(buf, buf + sizeof buf, x).ptr;
+    std::string t(buf, end);
+    if (t.find_first_of(".en") == std::string::npos) t += ".0";
+    return t;
+  };
+  auto quoted = [](const std::string& t) {
+    std::string q = "\"";
+    for (char c : t) {
+      if (c == '"' || c == '\\') q += '\\';
+      q += c;
+    }
+    return q + "\"";
+  };
+  return std::visit(
+      [&](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return real(x);
+        } else if constexpr (std::is_same_v<T, std::int64_t>) {
+          return std::to_string(x);
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return quoted(x);
+        } else if constexpr (std::is_same_v<T, bool>) {
+          return x ? "true" : "false";
+        } else {
+          std::string t = "[";
+          for (std::size_t k = 0; k < x.size(); ++k) {
+            if constexpr (std::is_same_v<T, std::vector<double>>) {
+              t += (k ? ", " : "") + real(x[k]);
+            } else {
+              t += (k ? ", " : "") + quoted(x[k]);
+            }
+          }
+          return t + "]";
+        }
+      },
+      v);
+}
+
+std::vector<std::string> splitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::string joinLines(const std::vector<std::string>& lines) {
+  std::string t;
+  for (const auto& l : lines) t += l + "\n";
+  return t;
+}
+
+// The table a key lives in and its last part: "loading.rate" -> {"loading", "rate"}.
+std::pair<std::string, std::string> splitKey(const std::string& key) {
+  const auto dot = key.rfind('.');
+  if (dot == std::string::npos) return {"", key};
+  return {key.substr(0, dot), key.substr(dot + 1)};
+}
+
+bool isHeaderOf(const std::string& line, const std::string& table) {
+  const auto a = line.find_first_not_of(" \t");
+  if (a == std::string::npos || line[a] != '[' || line.compare(a, 2, "[[") == 0) return false;
+  const auto b = line.find(']', a);
+  if (b == std::string::npos) return false;
+  std::string name;
+  for (char c : line.substr(a + 1, b - a - 1)) {
+    if (c != ' ' && c != '\t') name += c;
+  }
+  return name == table;
+}
+
+// The file's text with each override written in: on the line that gave the key (a line
+// holding the whole value), or under its table's header, or in a new table at the end.
+std::string editedText(const std::string& source,
+                       const std::vector<std::tuple<std::string, int, std::string>>& edits) {
+  std::vector<std::string> lines = splitLines(source);
+  std::vector<std::vector<std::string>> after(lines.size() + 1);  // lines to insert after [k]
+  std::string appended;
+  for (const auto& [key, line, written] : edits) {
+    const auto [table, leaf] = splitKey(key);
+    if (line > 0 && line <= static_cast<int>(lines.size())) {
+      std::string& l = lines[line - 1];
+      const auto eq = l.find('=');
+      if (eq == std::string::npos) return {};
+      std::string was = l.substr(eq + 1);
+      was.erase(0, was.find_first_not_of(" \t"));
+      l = l.substr(0, eq) + "= " + written + " (the file had: " + was + ")";
+      continue;
+    }
+    bool placed = false;
+    for (std::size_t k = 0; k < lines.size() && !placed; ++k) {
+      if (isHeaderOf(lines[k], table))
+        after[k + 1].push_back(leaf + " = " + written), placed = true;
+    }
+    if (!placed) appended += "\n[" + table + "]\n" + leaf + " = " + written + "\n";
+  }
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k <= lines.size(); ++k) {
+    for (auto& l : after[k]) out.push_back(std::move(l));
+    if (k < lines.size()) out.push_back(std::move(lines[k]));
+  }
+  return joinLines(out) + appended;
+}
+
+}  // namespace
+
+std::string Settings::effectiveText() const {
+  if (overrides_.empty()) return source_;
+  std::string head = "# The protocol as run: " + file_ + " with ";
+  std::vector<std::tuple<std::string, int, std::string>> edits;
+  for (const auto& [key, o] : overrides_) {
+    head += (edits.empty() ? "" : ", ") + o.label();
+    const int line = given_.count(key) ? given_.at(key) : 0;
+    edits.emplace_back(key, line, tomlLiteral(values_.at(key)) + "  # " + o.label());
+  }
+  head += "\n";
+  // The edited file reads back to these settings, or (an override inside a multi-line value
+  // or a table the file defines by dotted keys) every key is written out, table by table.
+  std::string text = editedText(source_, edits);
+  auto readsBack = [&](const std::string& t) {
+    try {
+      const Settings back = parseProtocol(file_, t, *schema_);
+      return back.values_ == values_;
+    } catch (const ProtocolError&) {
+      return false;
+    }
+  };
+  if (!text.empty() && readsBack(head + text)) return head + text;
+  std::map<std::string, std::vector<std::string>> tables;
+  std::vector<std::string> order;
+  for (const ParamDecl& d : schema_->all()) {
+    if (!given_.count(d.key)) continue;
+    const auto [table, leaf] = splitKey(d.key);
+    if (!tables.count(table)) order.push_back(table);
+    const auto o = overrides_.find(d.key);
+    tables[table].push_back(leaf + " = " + tomlLiteral(values_.at(d.key)) +
+                            (o == overrides_.end() ? "" : "  # " + o->second.label()));
+  }
+  text = head + "# (every key the file and the overrides give, written out)\n";
+  for (const std::string& t : order) {
+    text += "\n[" + t + "]\n";
+    for (const auto& l : tables[t]) text += l + "\n";
+  }
+  return text;
 }
 
 }  // namespace rocklab::protocol

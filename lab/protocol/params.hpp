@@ -74,6 +74,17 @@ class ProtocolError : public std::runtime_error {
   std::vector<std::string> problems_;
 };
 
+// A value given on the command line instead of in the file: `--set KEY=VALUE` (also the
+// values of a study's `--vary`). The value is TOML (`0.3`, `true`, `[1, 2]`, `"text"`); a
+// text key also takes it bare (`--set sample.kind=file`).
+struct Override {
+  std::string key, value;
+  std::string origin = "--set";  // what messages and the effective protocol text call it
+  std::string label() const { return origin + " " + key + "=" + value; }
+};
+// "KEY=VALUE" as typed; throws ProtocolError naming `origin` when there is no '='.
+Override parseOverride(const std::string& text, const std::string& origin = "--set");
+
 // The validated values of a protocol, in the units their keys name.
 class Settings {
  public:
@@ -84,33 +95,44 @@ class Settings {
   const std::vector<double>& list(const std::string& key) const;
   const std::vector<std::string>& texts(const std::string& key) const;
   bool given(const std::string& key) const { return given_.count(key) > 0; }
-  // Where a key was set, for errors found across keys ("file:line").
+  // Where a key was set, for errors found across keys: "file:line", or the override
+  // ("--set KEY=VALUE") that gave it.
   std::string where(const std::string& key) const;
   // Every parameter with its value (given or default) and unit.
   std::vector<notebook::ParamRow> table() const;
   const std::string& file() const { return file_; }
-  // Replaces a value after parsing (a command-line override); the range is checked.
+  // Replaces a value after parsing (the run's own choices: `--threads`, a seed of a seed
+  // series), not marked in the effective text; the range is checked.
   void override(const std::string& key, Value v);
-  // The same from command-line text (`--vary numerics.timestep_safety=0.3`), read as the
-  // key's kind; lists cannot be given this way.
-  void overrideText(const std::string& key, const std::string& text);
+  // Applies overrides as parseProtocol does: each validated like a key in the file, every
+  // problem reported at once naming the override; marked in effectiveText().
+  void apply(const std::vector<Override>& overrides);
   bool declared(const std::string& key) const;
   const ParamDecl& decl(const std::string& key) const;  // throws std::logic_error if undeclared
+  // The protocol file's text as read.
   const std::string& source() const { return source_; }
+  // The protocol as run: the file's text when nothing was overridden, else the text with
+  // each override written in and marked ("# --set ..."), so that parsing it alone gives
+  // these settings (the notebook keeps it; `rocklab rerun` runs it again).
+  std::string effectiveText() const;
 
  private:
-  friend Settings parseProtocol(const std::string&, const std::string&, const Schema&);
+  friend Settings parseProtocol(const std::string&, const std::string&, const Schema&,
+                                const std::vector<Override>&);
   const Value& value(const std::string& key) const;
   std::shared_ptr<const Schema> schema_;  // owned: settings outlive the schema they came from
   std::string file_, source_;
   std::map<std::string, Value> values_;
-  std::map<std::string, int> given_;  // key -> line
+  std::map<std::string, int> given_;           // key -> line (0: given by an override)
+  std::map<std::string, Override> overrides_;  // key -> the override that set it last
 };
 
 // Parses TOML text read from `file`, checks every key against the schema and returns the
 // settings; throws ProtocolError with all problems (unknown or missing keys, wrong types,
-// values out of range) each naming the file, line, key, allowed range and unit.
-Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema);
+// values out of range) each naming the file, line, key, allowed range and unit. Overrides
+// replace or add keys after the file's, validated the same way.
+Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema,
+                       const std::vector<Override>& overrides = {});
 
 // A problem found across several keys, in the same format ("file:line: key: why").
 [[noreturn]] void fail(const Settings& s, const std::string& key, const std::string& why);

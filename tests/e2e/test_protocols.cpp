@@ -535,6 +535,57 @@ TEST(Protocols, SigtermLeavesAnInterruptedRunWithItsData) {
   EXPECT_NE(scalar(n, "SELECT count(*) FROM series"), "0");
 }
 
+// A key set on the command line is checked like the file's, runs, is kept in the notebook's
+// protocol text, and `rerun` repeats the run from that text alone.
+TEST(Protocols, SetOverridesAKeyAndRerunRepeatsTheRun) {
+  Lab lab("set");
+  const std::string protocol = lab.path + ".protocol.toml";
+  std::filesystem::copy_file(sourceDir() + "/protocols/hydrostatic-quick.toml", protocol,
+                             std::filesystem::copy_options::overwrite_existing);
+  std::string out;
+  EXPECT_EQ(
+      rocklab::testing::runRocklab(
+          "run " + protocol + " --quiet --set loading.stress_max_MPa=-3 --lab " + lab.path, &out),
+      2);
+  EXPECT_NE(out.find("--set loading.stress_max_MPa=-3: loading.stress_max_MPa = -3 is outside "
+                     "the allowed range"),
+            std::string::npos)
+      << out;
+  EXPECT_FALSE(std::filesystem::exists(lab.path));  // nothing written
+  EXPECT_EQ(rocklab::testing::runRocklab("check " + protocol + " --set sample.count=600", &out), 0)
+      << out;
+  ASSERT_EQ(rocklab::testing::runRocklab("run " + protocol +
+                                             " --quiet --threads 1 --set sample.count=600 --set " +
+                                             "loading.stress_max_MPa=30 --lab " + lab.path,
+                                         &out),
+            0)
+      << out;
+  std::filesystem::remove(protocol);  // the notebook alone is enough to rerun
+  ASSERT_EQ(rocklab::testing::runRocklab("rerun 1 --quiet --threads 2 --lab " + lab.path, &out), 0)
+      << out;
+  nb::Notebook n(lab.path);
+  EXPECT_EQ(scalar(n, "SELECT value FROM params WHERE run_id = 1 AND key = 'sample.count'"), "600");
+  EXPECT_EQ(scalar(n, "SELECT value FROM params WHERE run_id = 2 AND key = 'sample.count'"), "600");
+  const std::string text = scalar(n, "SELECT protocol_text FROM runs WHERE id = 1");
+  EXPECT_NE(text.find("stress_max_MPa = 30.0  # --set loading.stress_max_MPa=30"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(scalar(n, "SELECT count(DISTINCT protocol_hash) FROM runs"), "1");
+  EXPECT_EQ(scalar(n,
+                   "SELECT count(*) FROM results a JOIN results b ON a.name = b.name "
+                   "AND b.run_id = 2 WHERE a.run_id = 1 AND a.value IS NOT b.value"),
+            "0");
+  EXPECT_EQ(scalar(n, "SELECT count(*) FROM results WHERE run_id = 2"),
+            scalar(n, "SELECT count(*) FROM results WHERE run_id = 1"));
+  EXPECT_NE(scalar(n, "SELECT count(*) FROM results WHERE run_id = 1"), "0");
+  EXPECT_DOUBLE_EQ(std::stod(scalar(n,
+                                    "SELECT max(value) FROM series WHERE run_id = 2 AND name = "
+                                    "'loading.axial_stress_MPa'")),
+                   std::stod(scalar(n,
+                                    "SELECT max(value) FROM series WHERE run_id = 1 AND name = "
+                                    "'loading.axial_stress_MPa'")));
+}
+
 TEST(Protocols, NotebookCommandsQueryTheLab) {
   Lab lab("queries");
   std::string out;

@@ -56,7 +56,7 @@ RunData syntheticRun(const rigs::RigEntry& rig, const protocol::Schema& schema,
   std::string text = "[protocol]\nname = \"t\"\nrig = \"" + r.rig + "\"\n[sample]\ncount = 10\n";
   if (r.rig == "ultrasonic") text += "[wave]\nfrequency_kHz = 100\n";
   protocol::Settings s = protocol::parseProtocol("synthetic.toml", text, schema);
-  for (const auto& [key, v] : overrides) s.overrideText(key, v);
+  for (const auto& [key, v] : overrides) s.apply({{key, v}});
   for (const auto& row : s.table()) r.params.emplace_back(row.key, row.value, row.unit);
   return r;
 }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -179,33 +180,99 @@ axial_stress_MPa = 30
 TEST(Protocol, CommandLineValuesAreReadAsTheKeysKindAndChecked) {
   const Schema sc = schema();
   Settings s = parseProtocol("p.toml", kGood, sc);
-  s.overrideText("numerics.local_damping", "0.35");
+  s.apply({parseOverride("numerics.local_damping=0.35"), parseOverride("sample.count = 500"),
+           parseOverride("bonds.negative_strength=resample"), parseOverride("output.quiet=true"),
+           parseOverride("loading.cycle_at_axial_strain=[0.001, 0.01, 0.03]")});
   EXPECT_DOUBLE_EQ(s.real("numerics.local_damping"), 0.35);
-  s.overrideText("sample.count", "500");
   EXPECT_EQ(s.integer("sample.count"), 500);
-  s.overrideText("bonds.negative_strength", "resample");
-  EXPECT_EQ(s.text("bonds.negative_strength"), "resample");
-  s.overrideText("output.quiet", "true");
+  EXPECT_EQ(s.text("bonds.negative_strength"), "resample");  // bare text for a text key
   EXPECT_TRUE(s.flag("output.quiet"));
+  EXPECT_EQ(s.list("loading.cycle_at_axial_strain").size(), 3u);
+  EXPECT_EQ(s.where("sample.count"), "--set sample.count=500");
   auto error = [&](const std::string& key, const std::string& text) {
     try {
-      s.overrideText(key, text);
+      s.apply({{key, text, "--vary"}});
     } catch (const ProtocolError& x) {
       return std::string(x.what());
     }
     return std::string("no error");
   };
-  EXPECT_NE(error("numerics.local_damping", "1.5").find("outside the allowed range [0, 1)"),
-            std::string::npos);
-  EXPECT_NE(error("numerics.local_damping", "fast").find("expects a number (-)"),
+  // The same messages as for the file's keys, at the override instead of a line.
+  EXPECT_EQ(error("numerics.local_damping", "1.5"),
+            "--vary numerics.local_damping=1.5: numerics.local_damping = 1.5 is outside the "
+            "allowed range [0, 1) (-)");
+  EXPECT_NE(error("numerics.local_damping", "fast").find("is not a value"), std::string::npos);
+  EXPECT_NE(error("numerics.local_damping", "\"fast\"").find("expects a number"),
             std::string::npos);
   EXPECT_NE(error("sample.count", "2.5").find("expects an integer"), std::string::npos);
   EXPECT_NE(error("bonds.negative_strength", "drop").find("one of: skip, resample"),
             std::string::npos);
-  EXPECT_NE(error("loading.cycle_at_axial_strain", "0.1").find("cannot be varied"),
+  EXPECT_NE(error("numerics.damping", "0.1").find("unknown key 'numerics.damping'"),
             std::string::npos);
-  EXPECT_NE(error("numerics.damping", "0.1").find("not a key"), std::string::npos);
   EXPECT_DOUBLE_EQ(s.real("numerics.local_damping"), 0.35);  // a refused value changes nothing
+  EXPECT_THROW(parseOverride("numerics.local_damping"), ProtocolError);
+}
+
+TEST(Protocol, OverridesAtParseTimeAreCheckedWithTheFileAndMayGiveRequiredKeys) {
+  const Schema sc = schema();
+  const std::string text = "[protocol]\nname = \"t\"\nrig = \"oedometer\"\n";
+  try {
+    parseProtocol("p.toml", text, sc);
+    ADD_FAILURE() << "a required key was missing";
+  } catch (const ProtocolError&) {
+  }
+  const Settings s =
+      parseProtocol("p.toml", text, sc, {parseOverride("formation.axial_stress_MPa=12")});
+  EXPECT_DOUBLE_EQ(s.real("formation.axial_stress_MPa"), 12.0);
+  try {
+    parseProtocol("p.toml", kGood + std::string("sample.count = 0.5\n"), sc,
+                  {parseOverride("formation.axial_stress_MPa=-1")});
+    ADD_FAILURE() << "no error";
+  } catch (const ProtocolError& e) {
+    ASSERT_EQ(e.problems().size(), 2u) << e.what();
+    EXPECT_EQ(e.problems()[0].rfind("p.toml:11: unknown key 'loading.sample.count'", 0), 0u)
+        << e.what();
+    EXPECT_EQ(e.problems()[1].rfind("--set formation.axial_stress_MPa=-1: ", 0), 0u) << e.what();
+  }
+}
+
+// The effective text reads back to the same settings, whether the override replaces a line
+// of the file, goes under an existing table or into a new one, or cannot be written in.
+TEST(Protocol, EffectiveTextReadsBackToTheSettingsWithTheOverridesMarked) {
+  const Schema sc = schema();
+  EXPECT_EQ(parseProtocol("p.toml", kGood, sc).effectiveText(), kGood);
+  const std::vector<Override> o = {parseOverride("formation.axial_stress_MPa=12.5"),
+                                   parseOverride("loading.cycle_at_axial_strain=[0.1]"),
+                                   parseOverride("numerics.local_damping=0.1234567890123"),
+                                   parseOverride("bonds.negative_strength=resample")};
+  const Settings s = parseProtocol("p.toml", kGood, sc, o);
+  const std::string effective = s.effectiveText();
+  EXPECT_NE(effective.find("axial_stress_MPa = 12.5  # --set formation.axial_stress_MPa=12.5 "
+                           "(the file had: 30)"),
+            std::string::npos)
+      << effective;
+  EXPECT_NE(effective.find("[numerics]\nlocal_damping = 0.1234567890123  # --set"),
+            std::string::npos)
+      << effective;
+  const Settings back = parseProtocol("p.toml", effective, sc);
+  for (const auto& row : s.table()) {
+    const auto it = std::find_if(back.table().begin(), back.table().end(),
+                                 [&](const auto& r) { return r.key == row.key; });
+    EXPECT_EQ(it->value, row.value) << row.key;
+  }
+  EXPECT_EQ(back.real("numerics.local_damping"), 0.1234567890123);  // every bit
+  // A multi-line list cannot be replaced in place: every key is written out instead.
+  const std::string multi = std::string(kGood) + "[sample]\ncount = 300\n";
+  const std::string spread = std::string("[protocol]\nname = \"t\"\nrig = \"oedometer\"\n") +
+                             "[formation]\naxial_stress_MPa = 30\n[loading]\n" +
+                             "cycle_at_axial_strain = [\n  0.002,\n  0.02,\n]\n";
+  const Settings m =
+      parseProtocol("p.toml", spread, sc, {parseOverride("loading.cycle_at_axial_strain=[0.5]")});
+  const Settings mb = parseProtocol("p.toml", m.effectiveText(), sc);
+  EXPECT_EQ(mb.list("loading.cycle_at_axial_strain"), std::vector<double>{0.5});
+  EXPECT_DOUBLE_EQ(mb.real("formation.axial_stress_MPa"), 30.0);
+  const Settings c = parseProtocol("p.toml", multi, sc, {parseOverride("sample.count=7")});
+  EXPECT_EQ(parseProtocol("p.toml", c.effectiveText(), sc).integer("sample.count"), 7);
 }
 
 // A section of two fields and a rule across them, as a rig's loading.
