@@ -123,6 +123,19 @@ int listKeys(const std::string& rig) {
   }
 }
 
+// The files the settings name (path keys) that exist: the notebook keeps their hash and a copy.
+std::vector<notebook::InputFile> inputsOf(const protocol::Settings& settings) {
+  std::vector<notebook::InputFile> inputs;
+  for (const auto& row : settings.table()) {
+    if (row.unit != units::path.name) continue;
+    const std::string path = settings.path(row.key);
+    if (!path.empty() && std::filesystem::is_regular_file(path)) {
+      inputs.push_back({row.key, std::filesystem::absolute(path).string()});
+    }
+  }
+  return inputs;
+}
+
 RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& settings,
                        const std::string& protocol_file, const std::string& lab, bool quiet) {
   notebook::Notebook nb(lab);
@@ -135,6 +148,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
   info.build_type = kBuildType;
   info.seed = settings.integer("protocol.seed");
   info.threads = static_cast<int>(settings.integer("numerics.threads"));
+  info.inputs = inputsOf(settings);
   notebook::RunWriter writer(nb, info, settings.table());
   NotebookRecorder notebook_rec(writer);
   rigs::CheckedRecorder rec(notebook_rec, rig.outputs(), std::string(rig.name));
@@ -188,6 +202,7 @@ int rerunProtocol(std::int64_t run, const RunOptions& o) {
     return 2;
   }
   std::string file, text, version;
+  std::vector<protocol::Override> overrides = overridesOf(o.sets);
   {
     notebook::Notebook nb(o.lab);
     notebook::requireRun(nb, run);
@@ -196,6 +211,19 @@ int rerunProtocol(std::int64_t run, const RunOptions& o) {
     s.bind(1, run);
     s.step();
     file = s.text(0), text = s.text(1), version = s.text(2);
+    // A file the run read that is gone or changed since: the notebook's copy stands in.
+    auto in = nb.db().prepare("SELECT key, path, sha256, copy FROM inputs WHERE run_id = ?");
+    in.bind(1, run);
+    while (in.step()) {
+      const std::string path = in.text(1);
+      if (std::filesystem::is_regular_file(path) && notebook::fileSha256(path) == in.text(2)) {
+        continue;
+      }
+      const std::string copy = std::filesystem::absolute(nb.resolve(in.text(3))).string();
+      std::cerr << "rerun: " << path << " is gone or changed since run " << run
+                << ": reading the notebook's copy " << copy << "\n";
+      overrides.insert(overrides.begin(), {in.text(0), "\"" + copy + "\"", "rerun"});
+    }
   }
   if (version != kGitRevision) {
     std::cerr << "warning: run " << run << " was made by rocklab " << version << ", this is "
@@ -203,7 +231,7 @@ int rerunProtocol(std::int64_t run, const RunOptions& o) {
   }
   rigs::CheckedProtocol c{nullptr, {}};
   try {
-    c = rigs::checkProtocolText(file, text, overridesOf(o.sets));
+    c = rigs::checkProtocolText(file, text, overrides);
   } catch (const protocol::ProtocolError& e) {
     std::cerr << "run " << run << "'s protocol (" << file << "):\n" << e.what() << "\n";
     return 2;

@@ -12,6 +12,7 @@
 #include "lab/cli/study_commands.hpp"
 #include "lab/core/contact_laws.hpp"
 #include "lab/core/packing_io.hpp"
+#include "lab/samples/lattice.hpp"
 #include "reports/report.hpp"
 
 namespace {
@@ -93,6 +94,48 @@ int runPackCommand(int dim, rocklab::PackingSpec spec, const std::string& dist, 
     const auto p = generatePacking<3>(spec, &report);
     finish(p);
     writePacking<3>(out, p, comment.str());
+  }
+  std::cout << "wrote " << out << "\n";
+  return 0;
+}
+
+struct LatticeOptions {
+  std::string kind;  // empty: a random packing
+  double spacing_mm = 2.0, radius_mm = 0.0, position = 0.0, radius = 0.0;
+  std::vector<int> cells;
+};
+
+int runLatticeCommand(const LatticeOptions& o, std::uint64_t seed, const std::string& out) {
+  using namespace rocklab;
+  LatticeSpec spec;
+  spec.kind = latticeKindOf(o.kind);
+  const int dim = latticeDimension(spec.kind);
+  if (static_cast<int>(o.cells.size()) != dim) {
+    throw std::runtime_error("--cells: a " + o.kind + " lattice is " + std::to_string(dim) +
+                             "D: give " + std::to_string(dim) + " counts, e.g. --cells " +
+                             (dim == 2 ? "20,30" : "10,10,15"));
+  }
+  for (int a = 0; a < dim; ++a) spec.cells[a] = o.cells[a];
+  spec.spacing = o.spacing_mm * 1e-3;
+  spec.radius = o.radius_mm * 1e-3;
+  spec.position_perturbation = o.position;
+  spec.radius_perturbation = o.radius;
+  spec.seed = seed;
+  std::ostringstream comment;
+  comment << "rocklab pack --lattice " << o.kind << ": spacing " << o.spacing_mm << " mm, radius "
+          << (o.radius_mm > 0 ? o.radius_mm : 0.5 * o.spacing_mm) << " mm, cells";
+  for (int c : o.cells) comment << " " << c;
+  comment << ", perturbation of positions " << o.position << " and radii " << o.radius
+          << " (relative), seed " << seed;
+  auto finish = [&](const auto& p) {
+    comment << "\n" << p.centers.size() << " particles, porosity " << p.porosity();
+    std::cout << comment.str() << "\n";
+    writePacking(out, p, comment.str());
+  };
+  if (dim == 2) {
+    finish(latticePacking<2>(spec));
+  } else {
+    finish(latticePacking<3>(spec));
   }
   std::cout << "wrote " << out << "\n";
   return 0;
@@ -375,10 +418,29 @@ void addPack(CLI::App& app, Action& action) {
     double dmin = 1.8, dmax = 2.2, dmean = 2.0, dstd = 0.1, phi_mean = -1.0, phi_std = 0.1;
   };
   auto o = std::make_shared<Pack>();
+  auto l = std::make_shared<LatticeOptions>();
   auto* p = app.add_subcommand(
       "pack",
       "Generate a packing: random placement, then radius expansion in a fixed box to a "
-      "target porosity");
+      "target porosity; or a regular lattice (--lattice). Protocols read it with "
+      "sample.kind = \"file\"");
+  p->add_option("--lattice", l->kind,
+                "A regular lattice instead: hex, square (2D), sc, bcc, fcc (3D)")
+      ->check(CLI::IsMember({"hex", "square", "sc", "bcc", "fcc"}));
+  p->add_option("--spacing-mm", l->spacing_mm, "Lattice: nearest-neighbour distance (mm)")
+      ->check(CLI::PositiveNumber);
+  p->add_option("--radius-mm", l->radius_mm,
+                "Lattice: particle radius (mm; default half the spacing)")
+      ->check(CLI::PositiveNumber);
+  p->add_option("--cells", l->cells, "Lattice: unit cells along x,y[,z], e.g. 10,10,15")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 100000));
+  p->add_option("--perturb-position", l->position,
+                "Lattice: each coordinate moved by up to this times the radius (uniform)")
+      ->check(CLI::Range(0.0, 1.0));
+  p->add_option("--perturb-radius", l->radius,
+                "Lattice: each radius scaled by 1 + up to +- this (uniform)")
+      ->check(CLI::Range(0.0, 0.9));
   p->add_option("--dim", o->dim, "2 (disks) or 3 (spheres)")->check(CLI::IsMember({2, 3}));
   p->add_option("--n", o->spec.count, "Particles")->check(CLI::Range(2, 50000000));
   p->add_option("--dist", o->dist, "Size distribution: uniform, normal or phi (Gaussian in phi)")
@@ -395,8 +457,9 @@ void addPack(CLI::App& app, Action& action) {
   p->add_option("--seed", o->spec.seed, "Random seed");
   p->add_option("--threads", o->spec.threads, "Threads")->check(CLI::Range(1, 1024));
   p->add_option("--out", o->out, "Output packing file")->required();
-  p->callback([&action, o] {
-    action = [o] {
+  p->callback([&action, o, l] {
+    action = [o, l] {
+      if (!l->kind.empty()) return runLatticeCommand(*l, o->spec.seed, o->out);
       return runPackCommand(o->dim, o->spec, o->dist, o->dmin, o->dmax, o->dmean, o->dstd,
                             o->phi_mean, o->phi_std, o->out);
     };

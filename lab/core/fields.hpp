@@ -48,8 +48,9 @@ struct Unit {
 };
 
 namespace units {
-inline constexpr Unit none{"-"};  // dimensionless numbers and counts
-inline constexpr Unit text{""};   // texts, flags and choices
+inline constexpr Unit none{"-"};     // dimensionless numbers and counts
+inline constexpr Unit text{""};      // texts, flags and choices
+inline constexpr Unit path{"path"};  // a file, relative to the protocol file that names it
 inline constexpr Unit m{"m"};
 inline constexpr Unit mm{"mm", 1e-3};
 inline constexpr Unit s{"s"};

@@ -83,7 +83,8 @@ struct PackingSpec {
   template <class F>
   void fields(F& f) {
     f(count, {"count", units::none, Range::closed(2, 5e7),
-              "number of particles (grains for kind = grains)", true});
+              "number of particles (grains for kind = grains); required unless the sample is "
+              "read from a file (kind = file)"});
     f.section("", sizes);
     f(porosity, {"porosity_initial", units::none, Range::closed(0.05, 0.9),
                  "porosity the packing is generated at (radius expansion), before formation"});

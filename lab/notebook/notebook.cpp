@@ -198,6 +198,18 @@ CREATE TABLE picks (
   PRIMARY KEY (wave_id, receiver, method)
 );
 )sql",
+      // 5 -> 6: the files a run read (sample files): name, hash and the copy kept.
+      R"sql(
+CREATE TABLE inputs (
+  run_id INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+  key TEXT NOT NULL,
+  path TEXT NOT NULL,
+  sha256 TEXT NOT NULL,
+  bytes INTEGER NOT NULL,
+  copy TEXT NOT NULL,
+  PRIMARY KEY (run_id, key)
+);
+)sql",
   };
   return m;
 }
@@ -297,7 +309,25 @@ RunWriter::RunWriter(Notebook& nb, const RunInfo& info, const std::vector<ParamR
   auto p = db.prepare("INSERT INTO params (run_id, key, value, unit) VALUES (?, ?, ?, ?)");
   for (const ParamRow& r : params)
     p.bind(1, id_).bind(2, r.key).bind(3, r.value).bind(4, r.unit).run();
+  keepInputs(info.inputs);
   t.commit();
+}
+
+void RunWriter::keepInputs(const std::vector<InputFile>& inputs) {
+  namespace fs = std::filesystem;
+  auto s = nb_.db().prepare(
+      "INSERT INTO inputs (run_id, key, path, sha256, bytes, copy) VALUES (?, ?, ?, ?, ?, ?)");
+  for (const InputFile& in : inputs) {
+    // The copy makes the notebook enough to rerun the run, whatever becomes of the file.
+    const fs::path dir = fs::path(nb_.runFilesDir(id_)) / "inputs";
+    fs::create_directories(dir);
+    const fs::path copy = dir / fs::path(in.path).filename();
+    fs::copy_file(in.path, copy, fs::copy_options::overwrite_existing);
+    const std::string relative =
+        fs::relative(fs::absolute(copy), fs::absolute(nb_.path()).parent_path()).string();
+    s.bind(1, id_).bind(2, in.key).bind(3, in.path).bind(4, fileSha256(in.path));
+    s.bind(5, static_cast<std::int64_t>(fs::file_size(in.path))).bind(6, relative).run();
+  }
 }
 
 RunWriter::~RunWriter() {

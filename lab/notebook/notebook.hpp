@@ -16,7 +16,7 @@
 
 namespace rocklab::notebook {
 
-inline constexpr int kSchemaVersion = 5;
+inline constexpr int kSchemaVersion = 6;
 
 // Opens a lab notebook, creating it if needed, and brings its schema up to date. Runs a
 // previous process left `running` on this host and that process is gone are marked failed.
@@ -45,6 +45,15 @@ class Notebook {
 enum class RunStatus { Running, Completed, Failed, Interrupted };
 std::string_view toString(RunStatus s);
 
+// The SHA-256 of a file's bytes, in hex (what `sha256sum` prints).
+std::string fileSha256(const std::string& path);
+
+// A file a run reads (a sample file): the notebook keeps its hash and a copy.
+struct InputFile {
+  std::string key;   // the protocol key naming it, e.g. sample.file
+  std::string path;  // as resolved when the run started
+};
+
 struct RunInfo {
   std::string protocol;       // protocol name
   std::string protocol_file;  // path it was read from
@@ -54,6 +63,7 @@ struct RunInfo {
   std::string build_type;
   std::int64_t seed = 0;
   int threads = 1;
+  std::vector<InputFile> inputs;
 };
 
 // Records one run. Rows are buffered and written in batched transactions (flush() or
@@ -108,6 +118,7 @@ class RunWriter {
   double last_flush_ = 0.0;
   bool finished_ = false;
   void flushIfDue();
+  void keepInputs(const std::vector<InputFile>& inputs);
 };
 
 // Current UTC time as ISO 8601 text.

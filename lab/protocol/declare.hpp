@@ -72,9 +72,10 @@ class SchemaBuilder {
     ParamDecl d;
     d.key = prefix_ + std::string(f.key);
     d.kind = kind;
-    d.unit = kind == Kind::Real || kind == Kind::RealList ? f.unit
-             : kind == Kind::Integer                      ? units::none
-                                                          : units::text;
+    d.unit = kind == Kind::Real || kind == Kind::RealList            ? f.unit
+             : kind == Kind::Integer                                 ? units::none
+             : kind == Kind::Text && f.unit.name == units::path.name ? units::path
+                                                                     : units::text;
     if (!f.required) d.fallback = std::move(fallback);
     d.range = f.range;
     d.doc = std::string(f.doc);
@@ -101,7 +102,9 @@ class SettingsReader {
     v = static_cast<I>(s_.integer(key(f)));
   }
   void operator()(bool& v, const Field& f) const { v = s_.flag(key(f)); }
-  void operator()(std::string& v, const Field& f) const { v = s_.text(key(f)); }
+  void operator()(std::string& v, const Field& f) const {
+    v = f.unit.name == units::path.name ? s_.path(key(f)) : s_.text(key(f));
+  }
   void operator()(std::vector<std::string>& v, const Field& f) const { v = s_.texts(key(f)); }
   template <class E, class C>
   void operator()(E& v, const Field& f, const C& choices) const {

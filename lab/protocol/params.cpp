@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -156,6 +157,12 @@ std::int64_t Settings::integer(const std::string& key) const {
 const std::string& Settings::text(const std::string& key) const {
   return std::get<std::string>(value(key));
 }
+std::string Settings::path(const std::string& key) const {
+  const std::string& v = text(key);
+  if (v.empty() || std::filesystem::path(v).is_absolute()) return v;
+  return (std::filesystem::path(file_).parent_path() / v).lexically_normal().string();
+}
+
 bool Settings::flag(const std::string& key) const {
   return std::get<bool>(value(key));
 }
@@ -282,7 +289,8 @@ const ParamDecl* declarationOf(const Schema& schema, const std::string& key, con
   }
   problems.at(line, "unknown key '" + key + "'" +
                         (best.empty() ? "" : "; did you mean '" + best + "'?") +
-                        " (`rocklab keys RIG` lists them)");
+                        " (`rocklab keys " + (schema.rig().empty() ? "RIG" : schema.rig()) +
+                        "` lists them)");
   return nullptr;
 }
 

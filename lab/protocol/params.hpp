@@ -91,6 +91,8 @@ class Settings {
   double real(const std::string& key) const;
   std::int64_t integer(const std::string& key) const;
   const std::string& text(const std::string& key) const;  // texts and choices
+  // A path key's value, relative to the protocol file's folder unless absolute ("" stays).
+  std::string path(const std::string& key) const;
   bool flag(const std::string& key) const;
   const std::vector<double>& list(const std::string& key) const;
   const std::vector<std::string>& texts(const std::string& key) const;

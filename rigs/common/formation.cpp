@@ -65,20 +65,31 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
   using Mode = typename LoadingFrame<D>::Mode;
   const FormationSettings& f = sp.settings.formation;
   auto& sim = *sp.sim;
-  // Densify isotropically at the lateral stress with the formation friction (a dense
-  // packing), then with the grains' own friction take the formation state: a deviatoric
-  // stress the low friction could not hold.
-  for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, f.lateral_stress, 0.0});
-  std::uint64_t steps = settle(sp, "densification", rec, control);
-  MaterialTable own;
-  for (const Material& m : sim.materials().all()) own.add(m);
-  own[0].friction = sp.settings.material.grain.friction;
-  sim.replaceMaterials(std::move(own));
-  for (int a = 0; a < D; ++a) {
-    const double target = a == Specimen<D>::kAxial ? f.axial_stress : f.lateral_stress;
-    sp.frame->set(a, Axis{Mode::Stress, 0.0, target, 0.0});
+  auto ownFriction = [&] {
+    MaterialTable own;
+    for (const Material& m : sim.materials().all()) own.add(m);
+    own[0].friction = sp.settings.material.grain.friction;
+    sim.replaceMaterials(std::move(own));
+  };
+  std::uint64_t steps = 0;
+  if (f.enabled) {
+    // Densify isotropically at the lateral stress with the formation friction (a dense
+    // packing), then with the grains' own friction take the formation state: a deviatoric
+    // stress the low friction could not hold.
+    for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, f.lateral_stress, 0.0});
+    steps = settle(sp, "densification", rec, control);
+    ownFriction();
+    for (int a = 0; a < D; ++a) {
+      const double target = a == Specimen<D>::kAxial ? f.axial_stress : f.lateral_stress;
+      sp.frame->set(a, Axis{Mode::Stress, 0.0, target, 0.0});
+    }
+    steps += settle(sp, "formation", rec, control);
+  } else {
+    // The sample as it came (a file's): the walls stay at its box, the contacts as they are.
+    ownFriction();
+    rec.message(sim.steps(), sim.time(), "info",
+                "formation.enabled = false: the sample is used as it is, walls at its box");
   }
-  steps += settle(sp, "formation", rec, control);
   rec.result("formation_steps", static_cast<double>(steps), "");
   rec.result("porosity_after_formation", sp.frame->porosity(), "");
   rec.result("coordination_after_formation", sim.coordinationNumber(), "");

@@ -10,6 +10,56 @@
 
 namespace rocklab::rigs {
 
+double metresPer(LengthUnit u) {
+  switch (u) {
+    case LengthUnit::M:
+      return 1.0;
+    case LengthUnit::Cm:
+      return 1e-2;
+    case LengthUnit::Mm:
+      return 1e-3;
+    case LengthUnit::Um:
+      return 1e-6;
+  }
+  return 1.0;
+}
+
+namespace {
+
+// The packing of a sample file, in the protocol's dimension.
+template <int D>
+Packing<D> filePacking(const SampleSettings& sample) {
+  return samplePacking<D>(readSampleFile(sample.file, sample.format, metresPer(sample.file_unit)),
+                          sample.file);
+}
+
+}  // namespace
+
+void SpecimenSettings::validate() const {
+  if (sample.kind != SampleKind::File) {
+    if (sample.packing.count == 0) {
+      throw InvalidParameter("sample", "sample.count",
+                             "missing: the number of particles (grains for kind = grains) to "
+                             "generate; only a sample read from a file (kind = file) has none");
+    }
+    return;
+  }
+  if (sample.file.empty()) {
+    throw InvalidParameter("sample", "sample.kind",
+                           "kind = file needs sample.file, the file of the particles");
+  }
+  // The file is read now, so that a bad one is refused before anything is written.
+  try {
+    if (protocol.dimension == 2) {
+      filePacking<2>(sample);
+    } else {
+      filePacking<3>(sample);
+    }
+  } catch (const std::runtime_error& e) {
+    throw InvalidParameter("sample", "sample.file", e.what());
+  }
+}
+
 namespace {
 
 // The grains' material with a given friction (formation uses its own), and the walls'.
@@ -36,6 +86,7 @@ Packing<D> makePacking(const SpecimenSettings& s, RunControl& control,
   aspect[D - 1] = sample.aspect_axial;
   const auto seed = static_cast<std::uint64_t>(s.protocol.seed);
   auto progress = [&](double f) { control.tick("packing", 0, f, "growth to the porosity"); };
+  if (sample.kind == SampleKind::File) return filePacking<D>(sample);
   if (sample.kind != SampleKind::Spheres) {
     GrainPackingSpec g;
     g.grains = sample.packing.count;

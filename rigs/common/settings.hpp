@@ -13,6 +13,7 @@
 #include "lab/core/grains.hpp"
 #include "lab/core/packing.hpp"
 #include "lab/core/simulation.hpp"
+#include "lab/samples/sample_files.hpp"
 
 namespace rocklab::rigs {
 
@@ -40,12 +41,22 @@ struct ProtocolInfo {
   }
 };
 
-enum class SampleKind { Spheres, Grains, Clumps };
+enum class SampleKind { Spheres, Grains, Clumps, File };
+enum class LengthUnit { M, Cm, Mm, Um };
+double metresPer(LengthUnit u);
 
-// The sample: the packing (the core's PackingSpec), its box and, for grains, their shape.
+// The sample: the packing (the core's PackingSpec, or a file the user brings), its box and,
+// for grains, their shape.
 struct SampleSettings {
   SampleKind kind = SampleKind::Spheres;
-  PackingSpec packing;
+  PackingSpec packing = [] {
+    PackingSpec p;
+    p.count = 0;  // none: required unless the sample is read from a file (validate)
+    return p;
+  }();
+  std::string file;  // sample.kind = file: the path, resolved against the protocol's folder
+  SampleFormat format = SampleFormat::Auto;
+  LengthUnit file_unit = LengthUnit::M;
   double aspect_axial = 1.0;        // -, the box's axial length over its lateral ones
   GrainShapeSpec grain_shape;       // sample.kind = grains or clumps
   double clump_break_stress = 0.0;  // Pa, sample.kind = clumps; 0: unbreakable
@@ -54,16 +65,46 @@ struct SampleSettings {
   void fields(F& f) {
     static constexpr Choice<SampleKind> kKinds[] = {{"spheres", SampleKind::Spheres},
                                                     {"grains", SampleKind::Grains},
-                                                    {"clumps", SampleKind::Clumps}};
+                                                    {"clumps", SampleKind::Clumps},
+                                                    {"file", SampleKind::File}};
+    static constexpr Choice<SampleFormat> kFormats[] = {
+        {"auto", SampleFormat::Auto}, {"rocklab", SampleFormat::Rocklab},
+        {"csv", SampleFormat::Csv},   {"lammps", SampleFormat::Lammps},
+        {"yade", SampleFormat::Yade}, {"vtp", SampleFormat::Vtp}};
+    static constexpr Choice<LengthUnit> kUnits[] = {{"m", LengthUnit::M},
+                                                    {"cm", LengthUnit::Cm},
+                                                    {"mm", LengthUnit::Mm},
+                                                    {"um", LengthUnit::Um}};
     f(kind,
       {"sample.kind",
        units::text,
        {},
        "spheres: one disk or sphere per grain; grains: breakable superparticles, pebbles "
        "joined by intragranular bonds (grains.*, grain_bonds.*; Li & Holt section 2.2); "
-       "clumps: the same shapes as rigid bodies (grains.*, clumps.*)"},
+       "clumps: the same shapes as rigid bodies (grains.*, clumps.*); file: the disks or "
+       "spheres of sample.file, formed and cemented like a generated sample unless "
+       "formation.enabled = false"},
       kKinds);
     f.section("sample.", packing);
+    f(file, {"sample.file",
+             units::path,
+             {},
+             "kind = file: the sample's particles (rocklab packing, CSV, LAMMPS data, Yade "
+             "text, VTK .vtp), relative to the protocol file"});
+    f(format,
+      {"sample.format",
+       units::text,
+       {},
+       "kind = file: the file's format; auto: by extension (.txt/.packing rocklab, .csv, "
+       ".data/.lmp lammps, .yade, .vtp)"},
+      kFormats);
+    f(file_unit,
+      {"sample.file_unit",
+       units::text,
+       {},
+       "kind = file: the length unit of the file's numbers where the file does not "
+       "name one (a CSV header may; the rocklab format is in metres)"},
+      kUnits);
     f(aspect_axial, {"sample.aspect_axial", units::none, Range::closed(0.1, 10),
                      "axial length over lateral length of the generated box"});
     f.section("grains.", grain_shape);
@@ -108,6 +149,7 @@ struct CementSettings {
 // Formation under stress (Li & Holt section 1): densified at the lateral stress with a low
 // friction, then brought to the formation state with the grains' own.
 struct FormationSettings {
+  bool enabled = true;
   double axial_stress = 30.0 * kMPa;
   double lateral_stress = 15.0 * kMPa;
   double friction = 0.0;
@@ -117,6 +159,11 @@ struct FormationSettings {
 
   template <class F>
   void fields(F& f) {
+    f(enabled, {"enabled",
+                units::text,
+                {},
+                "form the sample under stress (densify, then take the formation state); false: "
+                "use it as it is (a sample from a file), its walls at its box"});
     f(axial_stress,
       {"axial_stress_MPa", units::MPa, Range::leftOpen(0, 1e4), "axial stress of formation"});
     f(lateral_stress,
@@ -193,6 +240,10 @@ struct SpecimenSettings {
   ServoSettings servo;
   QuasiStaticLimits quasi_static;
   OutputSettings output;
+
+  // Rules across sections: a sample to build (a count, or a file that reads as a packing of
+  // the protocol's dimension).
+  void validate() const;
 
   template <class F>
   void fields(F& f) {

@@ -191,6 +191,15 @@ TEST(Cli, BadInputIsRefusedClearly) {
   EXPECT_NE(r.out.find("(mm)"), std::string::npos) << r.out;
   r = run("frobnicate");
   EXPECT_NE(r.status, 0);
+  // A generated sample needs its count; a lattice its cells in its dimension.
+  const std::string protocol = tempPath("no-count.toml");
+  std::ofstream(protocol) << "[protocol]\nname = \"n\"\nrig = \"hydrostatic\"\n";
+  r = run("check " + protocol);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("sample.count: missing"), std::string::npos) << r.out;
+  r = run("pack --lattice fcc --cells 3,3 --out /tmp/x.txt");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("give 3 counts"), std::string::npos) << r.out;
 }
 
 // A study or a regression check with bad input says what is wrong and runs nothing: every
@@ -209,11 +218,19 @@ TEST(Cli, StudyAndRegressRefuseBadInputBeforeRunning) {
       << r.out;
   r = study("--vary numerics.timestep=0.3");
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.out.find("numerics.timestep: not a key of biaxial protocols"), std::string::npos)
+  EXPECT_NE(r.out.find("--vary numerics.timestep=0.3: unknown key 'numerics.timestep' (`rocklab "
+                       "keys biaxial` lists them)"),
+            std::string::npos)
       << r.out;
   r = study("--vary sample.count=many");
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.out.find("sample.count = many: expects an integer"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--vary sample.count=many: 'many' is not a value"), std::string::npos)
+      << r.out;
+  r = study("--vary sample.count=1.5");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("--vary sample.count=1.5: 'sample.count' (-) expects an integer"),
+            std::string::npos)
+      << r.out;
   r = study("--vary numerics.timestep_safety");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.out.find("expects KEY=v1,v2"), std::string::npos) << r.out;

@@ -19,6 +19,7 @@
 #include <iterator>
 #include <thread>
 
+#include "lab/core/packing_io.hpp"
 #include "lab/notebook/queries.hpp"
 
 namespace {
@@ -533,6 +534,163 @@ TEST(Protocols, SigtermLeavesAnInterruptedRunWithItsData) {
   EXPECT_EQ(scalar(n, "SELECT status || ': ' || reason FROM runs"),
             "interrupted: terminated (SIGTERM)");
   EXPECT_NE(scalar(n, "SELECT count(*) FROM series"), "0");
+}
+
+namespace samples {
+
+// A packing written in the other codes' formats, each as its own tool writes it.
+void writeCsvMm(const std::string& path, const rocklab::Packing<3>& p) {
+  std::ofstream out(path);
+  out.precision(17);
+  out << "id,x_mm,y_mm,z_mm,r_mm\n";
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    out << i << "," << p.centers[i].x() * 1e3 << "," << p.centers[i].y() * 1e3 << ","
+        << p.centers[i].z() * 1e3 << "," << p.radii[i] * 1e3 << "\n";
+  }
+}
+
+void writeLammps(const std::string& path, const rocklab::Packing<3>& p) {
+  std::ofstream out(path);
+  out.precision(17);
+  out << "LIGGGHTS data file\n\n" << p.centers.size() << " atoms\n1 atom types\n\n";
+  for (int a = 0; a < 3; ++a) {
+    out << p.lo[a] << " " << p.hi[a] << " "
+        << "xyz"[a] << "lo "
+        << "xyz"[a] << "hi\n";
+  }
+  out << "\nAtoms # granular\n\n";
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    out << i + 1 << " 1 " << 2 * p.radii[i] << " 2650 " << p.centers[i].x() << " "
+        << p.centers[i].y() << " " << p.centers[i].z() << " 0 0 0\n";
+  }
+}
+
+void writeYade(const std::string& path, const rocklab::Packing<3>& p) {
+  std::ofstream out(path);
+  out.precision(17);
+  out << "#format x_y_z_r\n";
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    out << p.centers[i].x() << " " << p.centers[i].y() << " " << p.centers[i].z() << " "
+        << p.radii[i] << "\n";
+  }
+}
+
+void writeVtpLayer(const std::string& path, const rocklab::Packing<2>& p) {
+  std::ofstream out(path);
+  out.precision(17);
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\">\n<PolyData>\n"
+      << "<Piece NumberOfPoints=\"" << p.centers.size() << "\">\n<PointData>\n"
+      << "<DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">\n";
+  for (double r : p.radii) out << r << "\n";
+  out << "</DataArray>\n</PointData>\n<Points>\n"
+      << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& c : p.centers) out << c.x() << " " << c.y() << " 0\n";
+  out << "</DataArray>\n</Points>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+}
+
+}  // namespace samples
+
+// Every rig runs on a sample the user brings, in every format, formed and cemented like a
+// generated one or (formation.enabled = false) as it is; the notebook keeps the file's name,
+// hash and a copy, and a rerun reads the copy when the file is gone.
+TEST(Protocols, EveryRigRunsOnASampleFromAFile) {
+  Lab lab("files");
+  const std::string dir = lab.path + ".samples";
+  std::filesystem::create_directories(dir);
+  std::string out;
+  ASSERT_EQ(rocklab::testing::runRocklab("pack --n 500 --porosity 0.42 --d-min-mm 0.8 "
+                                         "--d-max-mm 1.2 --seed 3 --out " +
+                                             dir + "/s3.txt",
+                                         &out),
+            0)
+      << out;
+  ASSERT_EQ(rocklab::testing::runRocklab("pack --lattice hex --spacing-mm 1 --cells 14,9 "
+                                         "--perturb-radius 0.1 --out " +
+                                             dir + "/h2.txt",
+                                         &out),
+            0)
+      << out;
+  const auto s3 = rocklab::readPacking<3>(dir + "/s3.txt");
+  const auto h2 = rocklab::readPacking<2>(dir + "/h2.txt");
+  samples::writeCsvMm(dir + "/s3.csv", s3);
+  samples::writeLammps(dir + "/s3.data", s3);
+  samples::writeYade(dir + "/s3.yade", s3);
+  samples::writeVtpLayer(dir + "/h2.vtp", h2);
+  struct Case {
+    std::string protocol, file, extra;
+    std::size_t particles;
+  };
+  const std::vector<Case> cases = {
+      {"oedometer-formed-under-stress-quick", "s3.txt", "", s3.radii.size()},
+      {"hydrostatic-quick", "s3.csv", "", s3.radii.size()},
+      {"hydrostatic-quick", "s3.txt", " --set formation.enabled=false", s3.radii.size()},
+      {"permeameter-hydrostatic-3d-quick", "s3.data", "", s3.radii.size()},
+      {"ultrasonic-hydrostatic-quick", "s3.yade", "", s3.radii.size()},
+      {"biaxial-ucs-quick", "h2.vtp", "", h2.radii.size()},
+      {"triaxial-envelope-quick", "h2.txt", "", h2.radii.size()},
+  };
+  int cemented = 0;
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const Case& c = cases[k];
+    ASSERT_EQ(rocklab::testing::runRocklab("run " + sourceDir() + "/protocols/" + c.protocol +
+                                               ".toml --quiet --set sample.kind=file --set " +
+                                               "sample.file=" + dir + "/" + c.file + c.extra +
+                                               " --lab " + lab.path,
+                                           &out),
+              0)
+        << c.protocol << " on " << c.file << ":\n"
+        << out;
+    nb::Notebook n(lab.path);
+    const std::string run = std::to_string(k + 1);
+    EXPECT_EQ(scalar(n, "SELECT value FROM results WHERE name = 'particles' AND run_id = " + run),
+              std::to_string(c.particles))
+        << c.protocol;
+    EXPECT_EQ(scalar(n, "SELECT sha256 FROM inputs WHERE key = 'sample.file' AND run_id = " + run),
+              nb::fileSha256(dir + "/" + c.file));
+    const bool formed = c.extra.empty();
+    EXPECT_EQ(std::stod(scalar(n,
+                               "SELECT value FROM results WHERE name = 'formation_steps' AND "
+                               "run_id = " +
+                                   run)) > 0,
+              formed)
+        << c.protocol;
+    // Cemented like a generated sample where the protocol cements (the permeameter's do not).
+    if (scalar(n, "SELECT value FROM params WHERE key = 'bonds.enabled' AND run_id = " + run) ==
+        "true") {
+      ++cemented;
+      EXPECT_GT(std::stod(scalar(n,
+                                 "SELECT value FROM results WHERE name = 'bonds_installed' "
+                                 "AND run_id = " +
+                                     run)),
+                0)
+          << c.protocol;
+    }
+  }
+  EXPECT_EQ(cemented, 6);
+  // The file gone, a rerun reads the notebook's copy and finds the same results.
+  std::filesystem::remove(dir + "/s3.csv");
+  ASSERT_EQ(rocklab::testing::runRocklab("rerun 2 --quiet --lab " + lab.path, &out), 0) << out;
+  EXPECT_NE(out.find("reading the notebook's copy"), std::string::npos) << out;
+  nb::Notebook n(lab.path);
+  const std::string next = std::to_string(cases.size() + 1);
+  EXPECT_EQ(scalar(n,
+                   "SELECT count(*) FROM results a JOIN results b ON a.name = b.name AND "
+                   "b.run_id = " +
+                       next + " WHERE a.run_id = 2 AND a.value IS NOT b.value"),
+            "0");
+  EXPECT_NE(scalar(n, "SELECT count(*) FROM results WHERE run_id = " + next), "0");
+  // A bad file is refused with its line before anything is written.
+  std::ofstream(dir + "/bad.csv") << "x,y,z,r\n0,0,0,1\n0,0,x,1\n";
+  EXPECT_EQ(rocklab::testing::runRocklab("run " + sourceDir() +
+                                             "/protocols/hydrostatic-quick.toml --quiet --set "
+                                             "sample.kind=file --set sample.file=" +
+                                             dir + "/bad.csv --lab " + lab.path + ".bad",
+                                         &out),
+            2);
+  EXPECT_NE(out.find("bad.csv:3: column z: 'x' is not a finite number"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(lab.path + ".bad"));
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(lab.path + ".files");
 }
 
 // A key set on the command line is checked like the file's, runs, is kept in the notebook's

@@ -313,5 +313,19 @@ TEST_F(NotebookTest, DeletingARunRemovesItsRowsAndFiles) {
   std::filesystem::remove_all(path_ + ".files");
 }
 
+// FIPS 180-4's examples, the empty file, and one past a block boundary.
+TEST_F(NotebookTest, FileHashIsSha256) {
+  auto hashOf = [&](const std::string& bytes) {
+    std::ofstream(path_, std::ios::binary) << bytes;
+    return fileSha256(path_);
+  };
+  EXPECT_EQ(hashOf(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(hashOf("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(hashOf("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  EXPECT_EQ(hashOf(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
 }  // namespace
 }  // namespace rocklab::notebook
