@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""rocklab beside LIGGGHTS on the peers' standard scene (../shared/peers/README.md).
+"""rocklab beside LIGGGHTS (and Yade) on the benchmark scene of data/peers/README.md.
 
 Not part of `make test`: timings are not assertions. Runs rocklab and LIGGGHTS alternately
 on the same packing, on one core and on two, at least three times each, and prints the
@@ -8,14 +8,18 @@ rocklab on two threads >= 1.8x its own one-core figure, and the bonded variant o
 >= 0.6x the unbonded one on one core; the bonded runs alternate with the others, and the
 bonded scene's hash is checked once with the bonds one at a time, `--scalar-bonds`).
 
-usage: tests/bench_peers.py [--runs N] [--rocklab PATH] [--steps S] PACKING [PACKING ...]
-e.g.   tests/bench_peers.py ../shared/peers/packing_10k.txt ../shared/peers/packing_50k.txt
+usage: tests/bench_peers.py [--runs N] [--rocklab PATH] [--steps S] [--yade] [PACKING ...]
+e.g.   tests/bench_peers.py                        (data/peers/packing_10k and _50k)
+       tests/bench_peers.py --yade data/peers/packing_10k.txt.xz build/bench/packing_100k.txt
 
-LIGGGHTS comes from Debian. It is installed here without its recommended packages: ParaView
-conflicts with python3-vtk9, which libvtk9-dev (rocklab's VTK) needs.
+A packing ending in .xz (as shipped under data/peers) is decompressed into a temporary
+folder first. LIGGGHTS and Yade come from Debian, installed here when missing, without their
+recommended packages (ParaView conflicts with python3-vtk9, which libvtk9-dev needs). With
+--yade, Yade's timing of the same scene (data/peers/yade/bench.py) runs alternately too.
 """
 import argparse
 import json
+import lzma
 import os
 import re
 import shutil
@@ -26,17 +30,38 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-PEERS = os.path.normpath(os.path.join(ROOT, "..", "shared", "peers"))
+PEERS = os.path.join(ROOT, "data", "peers")
+YADE_LINE = re.compile(r"yade: (\d+) spheres, (\d+) steps, ([0-9.eE+-]+) s")
 LOOP = re.compile(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
 
 
-def ensure_liggghts():
-    if shutil.which("liggghts"):
+def ensure(program, packages):
+    if shutil.which(program):
         return
     sudo = [] if os.geteuid() == 0 else ["sudo"]
-    print("installing liggghts (Debian, without recommends) ...", file=sys.stderr)
+    print(f"installing {' '.join(packages)} (Debian, without recommends) ...", file=sys.stderr)
     subprocess.run(sudo + ["apt-get", "install", "-y", "-q", "--no-install-recommends",
-                           "liggghts", "openmpi-bin"], check=True)
+                           *packages], check=True)
+
+
+def plain(packing, tmp):
+    """The packing file itself, or its decompressed copy in tmp when it ends in .xz."""
+    if not packing.endswith(".xz"):
+        return packing
+    out = os.path.join(tmp, os.path.basename(packing)[:-3])
+    with lzma.open(packing) as src, open(out, "wb") as dst:
+        shutil.copyfileobj(src, dst)
+    return out
+
+
+def yade_rate(packing, threads, steps):
+    out = subprocess.run(["yade", f"-j{threads}", "-n", "-x",
+                          os.path.join(PEERS, "yade", "bench.py"), packing, str(steps)],
+                         check=True, capture_output=True, text=True).stdout
+    m = YADE_LINE.search(out)
+    if not m:
+        raise RuntimeError("no timing line in Yade's output:\n" + out[-2000:])
+    return int(m.group(1)) * int(m.group(2)) / float(m.group(3))
 
 
 def rocklab_rate(rocklab, packing, threads, steps, extra=()):
@@ -48,7 +73,7 @@ def rocklab_rate(rocklab, packing, threads, steps, extra=()):
 
 
 def liggghts_rate(lig_dir, procs, steps):
-    cmd = ["liggghts", "-in", os.path.join(PEERS, "in.bench"), "-var", "dir", lig_dir,
+    cmd = ["liggghts", "-in", os.path.join(PEERS, "liggghts", "in.bench"), "-var", "dir", lig_dir,
            "-var", "steps", str(steps), "-var", "warm", "100", "-var", "skin", "0.0002",
            "-log", "none"]
     if procs > 1:
@@ -64,7 +89,9 @@ def liggghts_rate(lig_dir, procs, steps):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("packings", nargs="+")
+    ap.add_argument("packings", nargs="*", default=[
+        os.path.join(PEERS, "packing_10k.txt.xz"), os.path.join(PEERS, "packing_50k.txt.xz")])
+    ap.add_argument("--yade", action="store_true", help="time Yade too (slow: about 10x)")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--steps", type=int, default=2000)
     ap.add_argument("--rocklab", default=os.path.join(ROOT, "build", "release", "rocklab"))
@@ -73,14 +100,18 @@ def main():
         sys.exit("--runs: at least 3 (medians of fewer say little on a shared machine)")
     if not os.access(a.rocklab, os.X_OK):
         sys.exit(a.rocklab + ": build rocklab first (make build)")
-    ensure_liggghts()
+    ensure("liggghts", ["liggghts", "openmpi-bin"])
+    if a.yade:
+        ensure("yade", ["yade"])
     rows = []
-    for packing in a.packings:
+    for source in a.packings:
         with tempfile.TemporaryDirectory() as tmp:
+            packing = plain(source, tmp)
             lig_dir = os.path.join(tmp, "lig")
-            subprocess.run([sys.executable, os.path.join(PEERS, "make_liggghts_input.py"),
-                            packing, lig_dir], check=True, capture_output=True)
-            r1, r2, l1, l2, rb, hashes, bonded_hashes = [], [], [], [], [], set(), set()
+            subprocess.run([sys.executable,
+                            os.path.join(PEERS, "liggghts", "make_liggghts_input.py"), packing,
+                            lig_dir], check=True, capture_output=True)
+            r1, r2, l1, l2, rb, y1, hashes, bonded_hashes = [], [], [], [], [], [], set(), set()
             for k in range(a.runs):
                 # Alternate the codes so a slow spell of the machine hits both.
                 l1.append(liggghts_rate(lig_dir, 1, a.steps))
@@ -94,13 +125,15 @@ def main():
                 rate, h = rocklab_rate(a.rocklab, packing, 1, a.steps, ["--bonded"])
                 rb.append(rate)
                 bonded_hashes.add(h)
+                if a.yade:
+                    y1.append(yade_rate(packing, 1, a.steps))
                 print(f"{os.path.basename(packing)} run {k + 1}: LIGGGHTS {l1[-1]:.3e} / "
                       f"{l2[-1]:.3e}, rocklab {r1[-1]:.3e} / {r2[-1]:.3e} (1 / 2 cores), "
                       f"bonded {rb[-1]:.3e} (1 core)", file=sys.stderr)
             bonded_hashes.add(rocklab_rate(a.rocklab, packing, 1, a.steps,
                                            ["--bonded", "--scalar-bonds"])[1])
             med = {n: statistics.median(v) for n, v in
-                   (("l1", l1), ("l2", l2), ("r1", r1), ("r2", r2), ("rb", rb))}
+                   (("l1", l1), ("l2", l2), ("r1", r1), ("r2", r2), ("rb", rb), ("y1", y1)) if v}
             same = len(hashes) == 1 and len(bonded_hashes) == 1
             rows.append((os.path.basename(packing), med, same))
     print(f"medians of {a.runs} alternating runs, particle-steps/s ({a.steps} timed steps)")
@@ -111,7 +144,9 @@ def main():
         print(f"{name:<18}{m['l1']:>12.3e}{m['r1']:>12.3e}{m['r1'] / m['l1']:>7.2f}"
               f"{m['l2']:>12.3e}{m['r2']:>12.3e}{m['r2'] / m['l2']:>7.2f}"
               f"{m['r2'] / m['r1']:>13.2f}{m['rb']:>12.3e}{m['rb'] / m['r1']:>10.2f}"
-              f"  {'yes' if same else 'NO'}")
+              f"  {'yes' if same else 'NO'}"
+              + (f"   Yade 1 core {m['y1']:.3e}, rocklab / Yade {m['r1'] / m['y1']:.1f}"
+                 if "y1" in m else ""))
 
 
 if __name__ == "__main__":

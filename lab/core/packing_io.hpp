@@ -1,5 +1,5 @@
 #pragma once
-// Packing files, the format of the peer benchmark (../shared/peers): lines starting with
+// Packing files, the format of the benchmark packings (data/peers): lines starting with
 // '#' are comments; then N; then the wall inner faces "xmin xmax ymin ymax [zmin zmax]"
 // (m); then one particle per line "x y [z] r" (m). Four wall values make a 2D file.
 

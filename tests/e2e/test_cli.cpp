@@ -164,6 +164,31 @@ TEST(Cli, BenchAgreesWithLiggghts) {
   EXPECT_NEAR(number(r.out, "wall_stress_end_Pa") / mean3(ref, "wall_stress_end_Pa"), 1.0, 0.01);
 }
 
+// The packings shipped compressed under data/peers are the very files the comparisons with
+// LIGGGHTS and Yade were made on: decompressed, they give the states recorded beside them.
+TEST(Cli, ShippedBenchPackingsKeepTheirStates) {
+  const std::string dir = std::string(ROCKLAB_SOURCE_DIR) + "/data/peers/";
+  std::ifstream states_file(dir + "bench-states.json");
+  const std::string states((std::istreambuf_iterator<char>(states_file)),
+                           std::istreambuf_iterator<char>());
+  for (const std::string name : {"packing_3k.txt", "packing_10k.txt", "packing_20k.txt"}) {
+    std::string packing = dir + name;
+    if (!std::filesystem::exists(packing)) {
+      packing = tempPath(name);
+      ASSERT_EQ(std::system(("xz -dc " + dir + name + ".xz > " + packing).c_str()), 0) << name;
+    }
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        states, m, std::regex("\"" + name + "\": \\{[^}]*\"state_hash\": \"([0-9a-f]+)\"")))
+        << name;
+    const auto r = run("bench --packing " + packing + " --threads 2 --json");
+    ASSERT_EQ(r.status, 0) << r.out;
+    EXPECT_NE(r.out.find("\"state_hash\": \"" + std::string(m[1]) + "\""), std::string::npos)
+        << name << ": " << r.out;
+    if (packing != dir + name) std::filesystem::remove(packing);
+  }
+}
+
 TEST(Cli, PackWritesAReadablePacking) {
   const auto out = tempPath("pack2d.txt");
   const auto r =

@@ -1,0 +1,76 @@
+#pragma once
+// What the end-to-end tests of protocols share: a notebook of their own per test, queries of
+// it, and a quick protocol run into it and held to its regression reference.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "lab/notebook/queries.hpp"
+#include "tests/e2e/command.hpp"
+
+namespace rocklab::testing {
+
+namespace nb = rocklab::notebook;
+
+inline std::string sourceDir() {
+  return ROCKLAB_SOURCE_DIR;
+}
+
+struct Lab {
+  std::string path;
+  explicit Lab(const std::string& name)
+      : path((std::filesystem::temp_directory_path() /
+              ("rocklab-e2e-" + std::to_string(::getpid()) + "-" + name + ".sqlite"))
+                 .string()) {
+    clean();
+  }
+  ~Lab() { clean(); }
+  void clean() {
+    for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(path + ext);
+  }
+};
+
+inline double result(nb::Notebook& n, const std::string& name) {
+  const auto t = nb::query(n, "SELECT value FROM results WHERE name = '" + name + "'");
+  EXPECT_EQ(t.rows.size(), 1u) << name;
+  return t.rows.empty() ? NAN : t.rows[0][0].real;
+}
+
+inline std::string scalar(nb::Notebook& n, const std::string& sql) {
+  const auto t = nb::query(n, sql);
+  return t.rows.empty() ? "" : t.rows[0][0].str();
+}
+
+// A series' values in step order.
+inline std::vector<double> seriesValues(nb::Notebook& n, const std::string& name) {
+  const auto t = nb::query(n, "SELECT value FROM series WHERE name = '" + name + "' ORDER BY step");
+  std::vector<double> v;
+  for (const auto& row : t.rows) v.push_back(row[0].real);
+  return v;
+}
+
+// Runs a quick protocol into its own notebook and returns it. Every quick protocol passes
+// here, so every one is also held to its regression reference: its key results within the
+// tolerances of tests/reference/<protocol>.toml (twice their spread over three seeds;
+// `make references` regenerates the files, for review).
+inline nb::Notebook runQuick(const Lab& lab, const std::string& protocol) {
+  std::string out;
+  EXPECT_EQ(rocklab::testing::runRocklab("run " + sourceDir() + "/protocols/" + protocol +
+                                             ".toml --quiet --threads 1 --lab " + lab.path,
+                                         &out),
+            0)
+      << out;
+  EXPECT_EQ(rocklab::testing::runRocklab("regress check " + sourceDir() + "/tests/reference/" +
+                                             protocol + ".toml --lab " + lab.path,
+                                         &out),
+            0)
+      << out;
+  return nb::Notebook(lab.path);
+}
+
+}  // namespace rocklab::testing

@@ -1,0 +1,66 @@
+// The long end-to-end runs (label full, `make test-full`): protocols whose checks the quicker
+// tests of the default run show in part already. The biaxial shear-band and compaction-band
+// protocols (1.4 million steps, the longest of all): the envelope sweep's tests at 4 and 18
+// MPa show their break modes, crushing and cap
+// (QuickProtocols.EnvelopeSweepGivesMohrCoulombLineAndCap); the compaction band normal to sigma_1
+// and its strain windows are shown here only.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "tests/e2e/protocol_support.hpp"
+
+namespace {
+
+using namespace rocklab::testing;
+
+// Low against high confinement (Figures 4 and 5): at 4 MPa mainly tensile intergranular
+// breaks and next to no crushing; at 18 MPa more shear breaks and much more crushing, and
+// the sample compacts (measured at 4 MPa: 156 tensile / 87 shear cement breaks, 2 crushed
+// grains; at 18 MPa: 138 / 252, 7 crushed grains, volumetric strain 1.2% at the peak).
+TEST(QuickProtocols, HighConfinementBreaksInShearAndCrushesGrains) {
+  Lab low_lab("shear-band"), high_lab("compaction-band");
+  nb::Notebook low = runQuick(low_lab, "biaxial-shear-band-quick");
+  nb::Notebook high = runQuick(high_lab, "biaxial-compaction-band-quick");
+  for (nb::Notebook* n : {&low, &high}) {
+    EXPECT_EQ(scalar(*n, "SELECT status FROM runs"), "completed");
+    // The servo holds sigma_3 within 1% once loading starts (the issue's bound).
+    EXPECT_LT(result(*n, "confining_stress_error_max"), 0.01);
+  }
+  EXPECT_GT(result(low, "broken_bonds_tensile"), result(low, "broken_bonds_shear"));
+  auto shear_share = [&](nb::Notebook& n) {
+    return result(n, "broken_bonds_shear") /
+           (result(n, "broken_bonds_shear") + result(n, "broken_bonds_tensile"));
+  };
+  EXPECT_GT(shear_share(high), shear_share(low) + 0.1);
+  EXPECT_GT(result(high, "crushed_grains"), 2 * std::max(1.0, result(low, "crushed_grains")));
+  EXPECT_GT(result(high, "peak_deviatoric_stress_MPa"), result(low, "peak_deviatoric_stress_MPa"));
+  EXPECT_GT(result(high, "volumetric_strain_at_peak"), 0.005);  // compaction, positive
+  // The low-confinement test dilates and localises in a band inclined to sigma_1 (the
+  // paper: about 35 deg; the issue accepts 25-45; measured 28.75 deg, 2.9 times the strained
+  // particles a uniform field would put there), the high-confinement one compacts (its
+  // critical point is the onset of compactive yield, measured at 0.84% axial strain; its
+  // band 89.25 deg, contrast 4.6).
+  EXPECT_EQ(result(low, "critical_is_compaction"), 0.0);
+  EXPECT_EQ(result(low, "band_is_compaction"), 0.0);
+  EXPECT_GT(result(low, "band_angle_deg"), 20.0);
+  EXPECT_LT(result(low, "band_angle_deg"), 50.0);
+  EXPECT_EQ(result(high, "critical_is_compaction"), 1.0);
+  EXPECT_EQ(result(high, "band_in_compaction_field"), 1.0);
+  EXPECT_EQ(result(high, "band_is_compaction"), 1.0);  // within 20 deg of normal to sigma_1
+  EXPECT_GT(result(high, "band_contrast"), 3.0);       // a band, not diffuse compaction
+  // The band of each twentieth of the strain range after the critical point is recorded;
+  // the band kept is the most contrasted of them and of the whole range's.
+  const std::vector<double> window_contrast = seriesValues(high, "band_window_contrast");
+  EXPECT_GE(window_contrast.size(), 5u);
+  EXPECT_EQ(seriesValues(high, "band_window_angle_deg").size(), window_contrast.size());
+  for (double c : window_contrast) EXPECT_LE(c, result(high, "band_contrast"));
+  // Every break is an event with its kind: intragranular breaks are the crushing.
+  EXPECT_EQ(std::stod(scalar(high,
+                             "SELECT count(*) FROM events WHERE granular = 'intra' AND "
+                             "stage = 'loading'")),
+            result(high, "broken_grain_bonds_tensile") + result(high, "broken_grain_bonds_shear"));
+}
+
+}  // namespace
