@@ -29,7 +29,9 @@ const std::vector<RigEntry>& rigTable() {
           "permeameter",
           "permeameter: pore fluid driven through the sample between fixed end pressures, "
           "steady flow every n steps, Darcy permeability under hydrostatic or biaxial / "
-          "triaxial loading"),
+          "triaxial loading",
+          "the pore fluid's state (its network and pressures) is not in the checkpoints yet, so "
+          "a resumed run would not end as an uninterrupted one; run it again"),
       rigEntry<ultrasonic::Settings, ultrasonic::run>(
           "ultrasonic",
           "ultrasonic bench: P and S waves (pz, px, szx, sxy) through copies of a sample at "

@@ -17,6 +17,8 @@ namespace rocklab::rigs {
 struct RigEntry {
   std::string_view name;
   std::string_view doc;
+  // Why a run of this rig cannot be resumed from its checkpoints; empty when it can.
+  std::string_view not_resumable;
   void (*declare)(protocol::Schema&);
   // Reads the settings into the rig's struct, which checks its rules across keys (throws
   // protocol::ProtocolError).
@@ -27,8 +29,12 @@ struct RigEntry {
 
 // A row for a rig whose settings are `S` and whose run is `Run`.
 template <class S, void (*Run)(const S&, Recorder&, RunControl&)>
-RigEntry rigEntry(std::string_view name, std::string_view doc) {
-  return {name, doc, [](protocol::Schema& s) { protocol::declare<S>(s); },
+RigEntry rigEntry(std::string_view name, std::string_view doc,
+                  std::string_view not_resumable = {}) {
+  return {name,
+          doc,
+          not_resumable,
+          [](protocol::Schema& s) { protocol::declare<S>(s); },
           [](const protocol::Settings& s) { (void)protocol::read<S>(s); },
           [](const protocol::Settings& s, Recorder& rec, RunControl& control) {
             Run(protocol::read<S>(s), rec, control);

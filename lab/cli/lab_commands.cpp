@@ -123,6 +123,8 @@ int listKeys(const std::string& rig) {
   }
 }
 
+namespace {
+
 // The files the settings name (path keys) that exist: the notebook keeps their hash and a copy.
 std::vector<notebook::InputFile> inputsOf(const protocol::Settings& settings) {
   std::vector<notebook::InputFile> inputs;
@@ -136,44 +138,121 @@ std::vector<notebook::InputFile> inputsOf(const protocol::Settings& settings) {
   return inputs;
 }
 
+// The recorder of a resumed run: what the rig records while it replays what it had done is
+// in the notebook already.
+class SkippedWhileReplaying : public rigs::Recorder {
+ public:
+  SkippedWhileReplaying(rigs::Recorder& inner, const rigs::RunControl& control)
+      : inner_(inner), control_(control) {}
+  void series(std::string_view name, std::uint64_t step, double time, double value) override {
+    if (!control_.replaying()) inner_.series(name, step, time, value);
+  }
+  void event(const rigs::EventRecord& e) override {
+    if (!control_.replaying()) inner_.event(e);
+  }
+  void result(std::string_view name, double value, std::string_view unit) override {
+    if (!control_.replaying()) inner_.result(name, value, unit);
+  }
+  void message(std::uint64_t step, double time, std::string_view level,
+               std::string_view text) override {
+    if (!control_.replaying()) inner_.message(step, time, level, text);
+  }
+  void stageTiming(std::string_view stage, double seconds, std::uint64_t calls) override {
+    if (!control_.replaying()) inner_.stageTiming(stage, seconds, calls);
+  }
+  void snapshot(std::string_view stage, std::string_view label, const Frame& frame) override {
+    if (!control_.replaying()) inner_.snapshot(stage, label, frame);
+  }
+  void wave(const rigs::WaveRecord& w) override {
+    if (!control_.replaying()) inner_.wave(w);
+  }
+
+ private:
+  rigs::Recorder& inner_;
+  const rigs::RunControl& control_;
+};
+
+rigs::Journal::Options journalOptions(const protocol::Settings& settings) {
+  rigs::Journal::Options o;
+  o.every_s = settings.real("output.checkpoint_every_s");
+  o.protocol_hash = notebook::hashText(settings.effectiveText());
+  o.code_version = kGitRevision;
+  return o;
+}
+
+}  // namespace
+
 RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& settings,
-                       const std::string& protocol_file, const std::string& lab, bool quiet) {
+                       const std::string& protocol_file, const std::string& lab, bool quiet,
+                       std::int64_t resume_run) {
   notebook::Notebook nb(lab);
-  notebook::RunInfo info;
-  info.protocol = settings.text("protocol.name");
-  info.protocol_file = std::filesystem::absolute(protocol_file).string();
-  info.protocol_text = settings.effectiveText();
-  info.rig = std::string(rig.name);
-  info.code_version = kGitRevision;
-  info.build_type = kBuildType;
-  info.seed = settings.integer("protocol.seed");
-  info.threads = static_cast<int>(settings.integer("numerics.threads"));
-  info.inputs = inputsOf(settings);
-  notebook::RunWriter writer(nb, info, settings.table());
-  NotebookRecorder notebook_rec(writer);
-  rigs::CheckedRecorder rec(notebook_rec, rig.outputs(), std::string(rig.name));
+  std::unique_ptr<notebook::RunWriter> writer;
+  std::optional<rigs::Journal> journal;
+  rigs::Journal::Options jo = journalOptions(settings);
+  if (resume_run > 0) {
+    jo.dir = nb.runFilesDir(resume_run) + "/checkpoints";
+    try {
+      journal.emplace(rigs::Journal::resuming(jo));
+    } catch (const std::runtime_error& e) {
+      std::cerr << "run " << resume_run << " cannot resume: " << e.what() << "\n";
+      return {2, resume_run};
+    }
+    writer = std::make_unique<notebook::RunWriter>(nb, resume_run, journal->resumeMark());
+  } else {
+    notebook::RunInfo info;
+    info.protocol = settings.text("protocol.name");
+    info.protocol_file = std::filesystem::absolute(protocol_file).string();
+    info.protocol_text = settings.effectiveText();
+    info.rig = std::string(rig.name);
+    info.code_version = kGitRevision;
+    info.build_type = kBuildType;
+    info.seed = settings.integer("protocol.seed");
+    info.threads = static_cast<int>(settings.integer("numerics.threads"));
+    info.inputs = inputsOf(settings);
+    writer = std::make_unique<notebook::RunWriter>(nb, info, settings.table());
+    jo.dir = nb.runFilesDir(writer->id()) + "/checkpoints";
+    journal.emplace(jo);
+  }
+  journal->setMark([w = writer.get()] { return w->mark(); });
 
   g_signal.store(0);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   rigs::RunControl control(!quiet && isatty(STDERR_FILENO), interruption);
-  std::cerr << "run " << writer.id() << ": " << info.protocol << " (" << info.rig << ") -> " << lab
-            << "\n";
-  RunOutcome out{0, writer.id()};
+  // A rig that cannot resume writes no checkpoints (they would promise what it cannot keep).
+  if (rig.not_resumable.empty()) control.setJournal(&*journal);
+  NotebookRecorder notebook_rec(*writer);
+  SkippedWhileReplaying replay_rec(notebook_rec, control);
+  rigs::CheckedRecorder rec(replay_rec, rig.outputs(), std::string(rig.name));
+  const std::int64_t id = writer->id();
+  if (resume_run > 0) {
+    std::cerr << "run " << id << ": " << settings.text("protocol.name") << " (" << rig.name
+              << ") resumes from " << journal->resumePoint() << " -> " << lab << "\n";
+  } else {
+    std::cerr << "run " << id << ": " << settings.text("protocol.name") << " (" << rig.name
+              << ") -> " << lab << "\n";
+  }
+  RunOutcome out{0, id};
+  auto checkpointTime = [&] {
+    rec.stageTiming("checkpoints", journal->writeSeconds(), journal->writes());
+  };
   try {
     rig.run(settings, rec, control);
     control.done();
-    writer.finish(notebook::RunStatus::Completed);
-    std::cerr << "run " << writer.id() << " completed\n";
+    checkpointTime();
+    writer->finish(notebook::RunStatus::Completed);
+    journal->clear();  // a completed run has nothing to resume
+    std::cerr << "run " << id << " completed\n";
   } catch (const rigs::Interrupted& e) {
     control.done();
-    writer.finish(notebook::RunStatus::Interrupted, e.what());
-    std::cerr << "run " << writer.id() << " interrupted: " << e.what() << "\n";
+    writer->finish(notebook::RunStatus::Interrupted, e.what());
+    std::cerr << "run " << id << " interrupted: " << e.what() << " (rocklab resume " << id
+              << " --lab " << lab << " continues it)\n";
     out.code = 130;
   } catch (const std::exception& e) {
     control.done();
-    writer.finish(notebook::RunStatus::Failed, e.what());
-    std::cerr << "run " << writer.id() << " failed: " << e.what() << "\n";
+    writer->finish(notebook::RunStatus::Failed, e.what());
+    std::cerr << "run " << id << " failed: " << e.what() << "\n";
     out.code = 1;
   }
   std::signal(SIGINT, SIG_DFL);
@@ -240,6 +319,54 @@ int rerunProtocol(std::int64_t run, const RunOptions& o) {
   if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
   std::cerr << "rerun of run " << run << "\n";
   return runSettings(*c.rig, settings, file, o.lab, o.quiet).code;
+}
+
+int resumeRun(std::int64_t run, const RunOptions& o) {
+  if (!std::filesystem::exists(o.lab)) {
+    std::cerr << "no lab notebook at '" << o.lab << "' (--lab PATH)\n";
+    return 2;
+  }
+  std::string file, text, version, status;
+  {
+    notebook::Notebook nb(o.lab);  // a run left running by a dead process is failed from here
+    notebook::requireRun(nb, run);
+    auto s = nb.db().prepare(
+        "SELECT protocol_file, protocol_text, code_version, status, host, pid FROM runs WHERE "
+        "id = ?");
+    s.bind(1, run);
+    s.step();
+    file = s.text(0), text = s.text(1), version = s.text(2), status = s.text(3);
+    if (status == "completed") {
+      std::cerr << "run " << run << " is completed: nothing to resume (rocklab rerun " << run
+                << " runs it again)\n";
+      return 2;
+    }
+    if (status == "running") {
+      std::cerr << "run " << run << " is still running (pid " << s.text(5) << " on " << s.text(4)
+                << ")\n";
+      return 2;
+    }
+  }
+  if (version != kGitRevision) {
+    std::cerr << "run " << run << " cannot resume: it was made by rocklab " << version
+              << ", this is " << kGitRevision
+              << ": only the same code continues a run bit for bit\n";
+    return 2;
+  }
+  rigs::CheckedProtocol c{nullptr, {}};
+  try {
+    c = rigs::checkProtocolText(file, text);
+  } catch (const protocol::ProtocolError& e) {
+    std::cerr << "run " << run << "'s protocol (" << file << "):\n" << e.what() << "\n";
+    return 2;
+  }
+  if (!c.rig->not_resumable.empty()) {
+    std::cerr << "run " << run << " cannot resume: " << c.rig->not_resumable << "\n";
+    return 2;
+  }
+  protocol::Settings settings = c.settings;
+  if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+  return runSettings(*c.rig, settings, file, o.lab, o.quiet, run).code;
 }
 
 int notebookCommand(const NotebookOptions& o) {

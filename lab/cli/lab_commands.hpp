@@ -23,6 +23,9 @@ int checkProtocol(const std::string& path, const std::vector<std::string>& sets)
 // `rocklab rerun`: a run of the notebook run again from its effective protocol text alone,
 // into the same notebook as a new run.
 int rerunProtocol(std::int64_t run, const RunOptions& o);
+// `rocklab resume`: a run that was killed, interrupted or failed continued from its last
+// checkpoint in the same notebook row, to the state an uninterrupted run ends in.
+int resumeRun(std::int64_t run, const RunOptions& o);
 // The --set arguments as overrides; throws protocol::ProtocolError for one without '='.
 std::vector<protocol::Override> overridesOf(const std::vector<std::string>& sets);
 
@@ -30,9 +33,11 @@ struct RunOutcome {
   int code = 0;  // as runProtocol's
   std::int64_t run = 0;
 };
-// Runs checked settings into the notebook `lab` as one run.
+// Runs checked settings into the notebook `lab` as one run, or (resume_run > 0) continues
+// that run of the notebook from its last checkpoint.
 RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& settings,
-                       const std::string& protocol_file, const std::string& lab, bool quiet);
+                       const std::string& protocol_file, const std::string& lab, bool quiet,
+                       std::int64_t resume_run = 0);
 int listKeys(const std::string& rig);
 
 struct NotebookOptions {

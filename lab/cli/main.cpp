@@ -241,6 +241,19 @@ void addRun(CLI::App& app, Action& action) {
   rr->callback([&action, ro, run] {
     action = [ro, run] { return rocklab::cli::rerunProtocol(*run, *ro); };
   });
+
+  auto so = std::make_shared<rocklab::cli::RunOptions>();
+  auto srun = std::make_shared<std::int64_t>(0);
+  auto* rs = app.add_subcommand(
+      "resume",
+      "Continue a run that was killed, interrupted or stopped from its last checkpoint, in the "
+      "same notebook row: it ends as an uninterrupted run would");
+  rs->add_option("run", *srun, "Run id")->required();
+  rs->add_option("--lab", so->lab, "Lab notebook (SQLite)");
+  rs->add_flag("--quiet", so->quiet, "No progress on stderr");
+  rs->add_option("--threads", so->threads, "Threads (same results)")->check(CLI::Range(1, 1024));
+  rs->callback(
+      [&action, so, srun] { action = [so, srun] { return rocklab::cli::resumeRun(*srun, *so); }; });
 }
 
 void addCheckAndKeys(CLI::App& app, Action& action) {

@@ -244,6 +244,11 @@ struct CementReport {
   std::size_t installed = 0;
   std::size_t skipped_nonpositive = 0;  // draws <= 0 with NegativeStrength::Skip
   std::size_t redrawn = 0;              // draws <= 0 drawn again (NegativeStrength::Resample)
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("candidates", candidates), ar("installed", installed);
+    ar("skipped_nonpositive", skipped_nonpositive), ar("redrawn", redrawn);
+  }
 };
 
 }  // namespace rocklab

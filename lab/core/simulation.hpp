@@ -188,6 +188,10 @@ class Simulation {
   // A deep copy through the checkpoint serializer (a branch of an experiment, a wave
   // measurement on a copy of a loaded sample); stage timings start anew.
   Simulation clone() const;
+  // The whole state as bytes of the checkpoint serializer, and a simulation made from them
+  // that continues bit for bit (a rig's checkpoint holds them beside the rig's own state).
+  std::string stateBytes() const;
+  static Simulation fromStateBytes(const std::string& bytes);
   // Starts the energy ledger anew from the present state.
   void restartEnergyLedger();
   Rng& rng() { return rng_; }

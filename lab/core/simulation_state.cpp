@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "lab/core/archive.hpp"
+#include "lab/core/contact_laws.hpp"
 
 namespace rocklab {
 
@@ -51,6 +52,24 @@ Simulation<D> Simulation<D>::clone() const {
   ArchiveReader r(w.bytes().data(), w.bytes().size());
   copy.visit(r);
   return copy;
+}
+
+template <int D>
+std::string Simulation<D>::stateBytes() const {
+  ArchiveWriter w;
+  const_cast<Simulation*>(this)->visit(w);
+  return w.bytes();
+}
+
+template <int D>
+Simulation<D> Simulation<D>::fromStateBytes(const std::string& bytes) {
+  Simulation s(MaterialTable{}, SimulationConfig{});
+  ArchiveReader r(bytes.data(), bytes.size());
+  s.visit(r);
+  // The contact model is made from the configuration and materials, not stored: readouts
+  // before the next step (the unbalanced force, the contacts) need it, as in the original.
+  s.model_ = makeContactModel<D>(s.config_.contact_law, s.materials_);
+  return s;
 }
 
 template <int D>
@@ -204,10 +223,12 @@ Simulation<D> Simulation<D>::loadCheckpoint(const std::string& path) {
   return sim;
 }
 
-#define ROCKLAB_STATE(D)                                                 \
-  template Simulation<D> Simulation<D>::clone() const;                   \
-  template std::uint64_t Simulation<D>::stateHash() const;               \
-  template void Simulation<D>::saveCheckpoint(const std::string&) const; \
+#define ROCKLAB_STATE(D)                                                    \
+  template Simulation<D> Simulation<D>::clone() const;                      \
+  template std::string Simulation<D>::stateBytes() const;                   \
+  template Simulation<D> Simulation<D>::fromStateBytes(const std::string&); \
+  template std::uint64_t Simulation<D>::stateHash() const;                  \
+  template void Simulation<D>::saveCheckpoint(const std::string&) const;    \
   template Simulation<D> Simulation<D>::loadCheckpoint(const std::string&);
 ROCKLAB_STATE(2)
 ROCKLAB_STATE(3)

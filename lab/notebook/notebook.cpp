@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <tuple>
 
 namespace rocklab::notebook {
@@ -28,6 +29,8 @@ std::string hostName() {
   return buf;
 }
 
+}  // namespace
+
 // FNV-1a, as text: the protocol's fingerprint.
 std::string hashText(std::string_view s) {
   std::uint64_t h = 1469598103934665603ull;
@@ -39,6 +42,12 @@ std::string hashText(std::string_view s) {
   std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
   return out;
 }
+
+namespace {
+
+// The tables a run's records go to, in the order a mark lists them.
+constexpr const char* kRecordTables[] = {"series",        "events",    "messages", "results",
+                                         "stage_timings", "snapshots", "waves"};
 
 }  // namespace
 
@@ -328,6 +337,48 @@ void RunWriter::keepInputs(const std::vector<InputFile>& inputs) {
     s.bind(1, id_).bind(2, in.key).bind(3, in.path).bind(4, fileSha256(in.path));
     s.bind(5, static_cast<std::int64_t>(fs::file_size(in.path))).bind(6, relative).run();
   }
+}
+
+RunWriter::RunWriter(Notebook& nb, std::int64_t run, const std::string& mark)
+    : nb_(nb), id_(run), started_(monotonicSeconds()), last_flush_(started_) {
+  Connection& db = nb_.db();
+  Transaction t(db);
+  // What the run recorded after the checkpoint it resumes from goes: it is recorded again.
+  std::istringstream in(mark);
+  for (std::string item; in >> item;) {
+    const auto colon = item.find(':');
+    const std::string table = item.substr(0, colon);
+    bool known = false;
+    for (const char* k : kRecordTables) known = known || table == k;
+    if (!known || colon == std::string::npos) {
+      throw SqlError("a checkpoint's notebook mark names no record table: '" + item + "'");
+    }
+    db.prepare("DELETE FROM " + table + " WHERE run_id = ? AND rowid > ?")
+        .bind(1, run)
+        .bind(2, static_cast<std::int64_t>(std::stoll(item.substr(colon + 1))))
+        .run();
+  }
+  auto s = db.prepare(
+      "UPDATE runs SET status = 'running', reason = NULL, finished = NULL, host = ?, pid = ? "
+      "WHERE id = ?");
+  s.bind(1, hostName()).bind(2, static_cast<std::int64_t>(getpid())).bind(3, run).run();
+  auto w = db.prepare("SELECT coalesce(wall_seconds, 0) FROM runs WHERE id = ?");
+  w.bind(1, run);
+  if (w.step()) started_ -= w.real(0);  // the wall time counts both parts
+  t.commit();
+}
+
+std::string RunWriter::mark() {
+  flush();
+  std::string m;
+  for (const char* table : kRecordTables) {
+    auto s = nb_.db().prepare(std::string("SELECT coalesce(max(rowid), 0) FROM ") + table +
+                              " WHERE run_id = ?");
+    s.bind(1, id_);
+    s.step();
+    m += (m.empty() ? "" : " ") + std::string(table) + ":" + std::to_string(s.integer(0));
+  }
+  return m;
 }
 
 RunWriter::~RunWriter() {

@@ -45,6 +45,9 @@ class Notebook {
 enum class RunStatus { Running, Completed, Failed, Interrupted };
 std::string_view toString(RunStatus s);
 
+// FNV-1a of a text, as 16 hex digits: a protocol's fingerprint (runs.protocol_hash).
+std::string hashText(std::string_view s);
+
 // The SHA-256 of a file's bytes, in hex (what `sha256sum` prints).
 std::string fileSha256(const std::string& path);
 
@@ -72,6 +75,9 @@ struct RunInfo {
 class RunWriter {
  public:
   RunWriter(Notebook& nb, const RunInfo& info, const std::vector<ParamRow>& params);
+  // Continues run `run` (rocklab resume): its records after `mark` (what mark() returned at
+  // the checkpoint resumed from) are removed, its status is running again.
+  RunWriter(Notebook& nb, std::int64_t run, const std::string& mark);
   ~RunWriter();
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
@@ -89,6 +95,8 @@ class RunWriter {
                 std::uint64_t step, double time, const std::string& bytes,
                 std::string_view extension);
   void flush();
+  // Writes everything buffered and returns how far the run's records go in each table.
+  std::string mark();
   void finish(RunStatus status, std::string_view reason = {});
 
  private:

@@ -12,6 +12,7 @@
 
 #include "lab/core/frame.hpp"
 #include "lab/notebook/records.hpp"
+#include "rigs/common/journal.hpp"
 
 namespace rocklab::rigs {
 
@@ -48,6 +49,13 @@ class RunControl {
   // `fraction` < 0 when the stage's length is not known in advance.
   void tick(std::string_view stage, std::uint64_t steps, double fraction, std::string_view detail);
   void done();  // ends the progress line
+  // The run's checkpoints (none: units always run, nothing is written).
+  void setJournal(Journal* j) { journal_ = j; }
+  Journal::Unit unit(std::string_view name) {
+    return journal_ ? journal_->begin(name) : Journal::Unit{};
+  }
+  // True while a resumed run replays what it had done: nothing is recorded.
+  bool replaying() const { return journal_ && journal_->replaying(); }
 
  private:
   bool show_;
@@ -57,6 +65,7 @@ class RunControl {
   std::string stage_;
   std::uint64_t stage_steps0_ = 0;
   bool printed_ = false;
+  Journal* journal_ = nullptr;
 };
 
 }  // namespace rocklab::rigs

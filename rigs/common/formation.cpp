@@ -13,20 +13,26 @@ namespace {
 template <int D>
 std::uint64_t settle(Specimen<D>& sp, const std::string& stage, Recorder& rec,
                      RunControl& control) {
+  Journal::Unit unit = control.unit("settle " + stage);
+  std::uint64_t start = sp.sim->steps(), done = 0;
+  if (unit.done(done, sp)) return done;
+  unit.resume(start, sp);
   auto& sim = *sp.sim;
   const FormationSettings& f = sp.settings.formation;
   const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
   const auto max_steps = static_cast<std::uint64_t>(f.max_steps);
-  const std::uint64_t start = sim.steps();
-  for (;;) {
+  for (;; unit.tick(start, sp)) {
     sp.frame->step();
-    const std::uint64_t done = sim.steps() - start;
+    done = sim.steps() - start;
     if (done % record_every == 0) recordState(sp, rec, stage + ".", stage, 0.0);
     if (done % 100 != 0) continue;
     const double err = sp.frame->stressError(), u = sim.unbalancedForceRatio();
     control.tick(stage, sim.steps(), -1.0,
                  "stress error " + fmt(err) + ", unbalanced force ratio " + fmt(u));
-    if (err < f.stress_tolerance && u < f.unbalanced_force_ratio) return done;
+    if (err < f.stress_tolerance && u < f.unbalanced_force_ratio) {
+      unit.finish(done, sp);
+      return done;
+    }
     if (done >= max_steps) {
       std::ostringstream why;
       why << stage << " did not settle in " << done << " steps: the wall stresses miss their "
@@ -103,35 +109,52 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
   snapshot(sp, rec, "formation", "formed");
 }
 
+// A servo ramp's course: where it started, where it goes, in how long (the loop state a
+// checkpoint inside the ramp keeps).
+template <int D>
+struct Ramp {
+  std::array<double, D> from{}, to{};
+  double duration = 0.0, t0 = 0.0;
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("from", from), ar("to", to), ar("duration", duration), ar("t0", t0);
+  }
+};
+
 template <int D>
 void servoTo(Specimen<D>& sp, double axial, double lateral, double rate, const std::string& stage,
              Recorder& rec, RunControl& control) {
   using Axis = typename LoadingFrame<D>::Axis;
   using Mode = typename LoadingFrame<D>::Mode;
-  auto& sim = *sp.sim;
   constexpr int ax = Specimen<D>::kAxial;
   const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
-  std::array<double, D> from, to;
-  double span = 0.0;
-  for (int a = 0; a < D; ++a) {
-    from[a] = sp.frame->stress(a);
-    to[a] = a == ax ? axial : lateral;
-    span = std::max(span, std::abs(to[a] - from[a]));
-  }
-  const double duration = span / rate;
-  for (int a = 0; a < D; ++a) {
-    sp.frame->set(a, Axis{Mode::Stress, 0.0, from[a], (to[a] - from[a]) / duration});
-  }
-  const double t0 = sim.time();
-  while (sim.time() - t0 < duration) {
-    sp.frame->step();
-    if (sim.steps() % record_every == 0) recordState(sp, rec, stage + ".", stage, 0.0);
-    if (sim.steps() % 100 == 0) {
-      control.tick(stage, sim.steps(), (sim.time() - t0) / duration,
-                   "axial " + fmt(sp.frame->stress(ax) / 1e6) + " MPa");
+  Journal::Unit unit = control.unit("ramp " + stage);
+  Ramp<D> r;
+  if (!unit.done(r, sp)) {
+    double span = 0.0;
+    for (int a = 0; a < D; ++a) {
+      r.from[a] = sp.frame->stress(a);
+      r.to[a] = a == ax ? axial : lateral;
+      span = std::max(span, std::abs(r.to[a] - r.from[a]));
     }
+    r.duration = span / rate;
+    for (int a = 0; a < D; ++a) {
+      sp.frame->set(a, Axis{Mode::Stress, 0.0, r.from[a], (r.to[a] - r.from[a]) / r.duration});
+    }
+    r.t0 = sp.sim->time();
+    unit.resume(r, sp);
+    auto& sim = *sp.sim;
+    for (; sim.time() - r.t0 < r.duration; unit.tick(r, sp)) {
+      sp.frame->step();
+      if (sim.steps() % record_every == 0) recordState(sp, rec, stage + ".", stage, 0.0);
+      if (sim.steps() % 100 == 0) {
+        control.tick(stage, sim.steps(), (sim.time() - r.t0) / r.duration,
+                     "axial " + fmt(sp.frame->stress(ax) / 1e6) + " MPa");
+      }
+    }
+    for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, r.to[a], 0.0});
+    unit.finish(r, sp);
   }
-  for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, to[a], 0.0});
   settle(sp, stage, rec, control);
 }
 

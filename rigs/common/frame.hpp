@@ -21,6 +21,11 @@ class LoadingFrame {
     double strain_rate = 0.0;  // 1/s, compression positive (StrainRate)
     double stress = 0.0;       // Pa, compression positive, at the moment it is set (Stress)
     double stress_rate = 0.0;  // Pa/s (Stress: a ramp)
+    template <class Archive>
+    void visit(Archive& ar) {
+      ar("mode", mode), ar("strain_rate", strain_rate), ar("stress", stress);
+      ar("stress_rate", stress_rate);
+    }
   };
 
   // Adds the walls on the faces of [lo, hi]; wall 2a bounds axis a from below, 2a + 1 from
@@ -32,6 +37,18 @@ class LoadingFrame {
   void attach(Simulation<D>& sim) {
     sim_ = &sim;
     effect_ = nullptr;
+  }
+  // A frame read back from a checkpoint (visit) around a simulation read back with it: its
+  // walls are already the simulation's.
+  struct Restored {};
+  LoadingFrame(Simulation<D>& sim, Restored) : sim_(&sim) {}
+  // The frame's own state, for checkpoints (the walls are the simulation's; a coupled effect
+  // is set again by the rig).
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("axes", axes_), ar("reference", reference_), ar("solid_volume", solid_volume_);
+    ar("servo_alpha", servo_alpha_), ar("servo_max_speed", servo_max_speed_);
+    ar("effect_interval", effect_interval_);
   }
 
   void set(int axis, const Axis& a);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <numeric>
 #include <sstream>
@@ -146,6 +147,14 @@ void recordTimings(Recorder& rec, const std::vector<const Simulation<D>*>& sims)
     }
   }
   for (const StageTiming& t : total) rec.stageTiming(t.name, t.seconds, t.calls);
+  // The end states bit for bit: a resumed or rerun run is the same run when these agree.
+  for (const auto* sim : sims) {
+    char hash[17];
+    std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(sim->stateHash()));
+    rec.message(
+        sim->steps(), sim->time(), "info",
+        "final state hash " + std::string(hash) + " at step " + std::to_string(sim->steps()));
+  }
 }
 
 template <int D>

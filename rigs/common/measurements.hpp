@@ -27,7 +27,8 @@ void recordBreaks(Specimen<D>& sp, Recorder& rec, const std::string& stage);
 template <int D>
 void snapshot(Specimen<D>& sp, Recorder& rec, const std::string& stage, const std::string& label);
 
-// The stage timings of the simulations an experiment ran (branches summed), to the recorder.
+// The stage timings of the simulations an experiment ran (branches summed), to the recorder,
+// and each one's final state hash (a message).
 template <int D>
 void recordTimings(Recorder& rec, const std::vector<const Simulation<D>*>& sims);
 

@@ -140,6 +140,12 @@ void makeClumps(Simulation<D>& sim, const std::vector<ParticleId>& ids,
 
 template <int D>
 Specimen<D> buildSpecimen(const SpecimenSettings& s, RunControl& control) {
+  Journal::Unit unit = control.unit("sample");
+  {
+    Specimen<D> restored;
+    restored.settings = s;
+    if (unit.done(restored)) return restored;
+  }
   control.tick("packing", 0, -1.0, "random placement and growth");
   std::vector<std::uint32_t> grain;
   std::vector<double> aspect_ratios;
@@ -178,6 +184,7 @@ Specimen<D> buildSpecimen(const SpecimenSettings& s, RunControl& control) {
   sp.frame = std::make_unique<LoadingFrame<D>>(sim, p.lo, p.hi, 1);
   sim.prepare();
   sp.frame->setServo(s.servo.alpha, s.servo.speed_radii_per_step * sp.mean_radius / sim.dt());
+  unit.finish(sp);
   return sp;
 }
 

@@ -213,6 +213,7 @@ struct OutputSettings {
   std::int64_t record_every_steps = 500;
   bool snapshots = true;
   std::int64_t snapshot_every_steps = 0;  // 0: only at the ends of stages
+  double checkpoint_every_s = 60.0;       // wall time between checkpoints inside a stage
 
   template <class F>
   void fields(F& f) {
@@ -225,6 +226,10 @@ struct OutputSettings {
                   "formed and at the end of each loading stage, for reports and ParaView"});
     f(snapshot_every_steps, {"snapshot_every_steps", units::none, Range::closed(0, 1e12),
                              "also save a frame every this many loading steps (0: none)"});
+    f(checkpoint_every_s,
+      {"checkpoint_every_s", units::s, Range::closed(0.01, 1e7),
+       "wall time between checkpoints inside a stage (one is written at every stage's end "
+       "too): how much of a killed run `rocklab resume` must do again"});
   }
 };
 

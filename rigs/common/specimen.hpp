@@ -57,6 +57,10 @@ struct Specimen {
   std::uint64_t brokenInGrains(BondBreakMode mode) const;  // intragranular
   std::size_t crushedGrains() const;  // grains in more fragments than at the reference
   void resetBrokenCount();
+  // The specimen's state for a run's checkpoints (rigs/common/journal.hpp): the
+  // simulation, the frame and what the rig keeps; reading back rebuilds them.
+  template <class Archive>
+  void journal(Archive& ar);
 };
 
 // Generates the packing, builds the simulation with the protocol's material (friction

@@ -17,6 +17,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
+#include <random>
 #include <thread>
 
 #include "lab/core/packing_io.hpp"
@@ -436,6 +438,167 @@ TEST(Protocols, SigtermLeavesAnInterruptedRunWithItsData) {
   EXPECT_EQ(scalar(n, "SELECT status || ': ' || reason FROM runs"),
             "interrupted: terminated (SIGTERM)");
   EXPECT_NE(scalar(n, "SELECT count(*) FROM series"), "0");
+}
+
+namespace resume {
+
+// Every row of a query, each as one text: what two notebooks must agree on.
+std::vector<std::string> rows(const std::string& lab, const std::string& sql) {
+  std::vector<std::string> out;
+  for (const auto& row : nb::readOnlyQuery(lab, sql).rows) {
+    std::string line;
+    for (const auto& cell : row) line += cell.str() + "|";
+    out.push_back(line);
+  }
+  return out;
+}
+
+// Starts `rocklab ARGS` as a child process.
+pid_t start(const std::vector<std::string>& args) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(ROCKLAB_BINARY)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    std::freopen("/dev/null", "w", stderr);
+    execv(ROCKLAB_BINARY, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// Kills the run with SIGKILL `delay_s` after its loading has begun to reach the notebook,
+// as a node lost or a wall-clock limit would; false if it ended first.
+bool killDuringLoading(pid_t pid, const std::string& lab, double delay_s) {
+  for (;;) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) return false;
+    try {
+      if (rows(lab, "SELECT 1 FROM series WHERE name LIKE 'loading.%' LIMIT 1").size() == 1) break;
+    } catch (const std::exception&) {  // the notebook is not there yet
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFSIGNALED(status);
+}
+
+// The killed and resumed run against the uninterrupted one: every series row, event,
+// result and wave, and the final state's hash.
+void expectSameRun(const std::string& reference, const std::string& resumed) {
+  for (const char* sql :
+       {"SELECT name, step, time_s, value FROM series ORDER BY name, step",
+        "SELECT kind, step, stage, mode, x, y, z, particle_a, particle_b, granular, value FROM "
+        "events ORDER BY step, particle_a, particle_b, kind",
+        "SELECT name, value, unit FROM results ORDER BY name",
+        "SELECT text FROM messages WHERE text LIKE 'final state hash%' ORDER BY text",
+        "SELECT stage, label, step FROM snapshots ORDER BY step, label",
+        "SELECT status FROM runs"}) {
+    const auto a = rows(reference, sql), b = rows(resumed, sql);
+    EXPECT_EQ(a.size(), b.size()) << sql;
+    EXPECT_TRUE(a == b) << sql;
+  }
+  EXPECT_EQ(rows(resumed, "SELECT count(*) FROM messages WHERE text LIKE 'final state hash%'"),
+            std::vector<std::string>{"1|"});
+}
+
+std::vector<std::string> quickHydrostatic(const std::string& lab) {
+  return {"run",
+          sourceDir() + "/protocols/hydrostatic-quick.toml",
+          "--quiet",
+          "--threads",
+          "1",
+          "--set",
+          "sample.count=600",
+          "--set",
+          "output.checkpoint_every_s=0.2",
+          "--lab",
+          lab};
+}
+
+}  // namespace resume
+
+// A run killed (SIGKILL) at a random moment of its loading and resumed ends as the run that
+// was never killed: the same final state, every record once (the delay after the loading's
+// first records is drawn anew each time; it is printed when the test fails).
+TEST(Protocols, AKilledRunResumesToTheUninterruptedRun) {
+  Lab reference("resume-reference"), killed("resume-killed");
+  std::string out;
+  ASSERT_EQ(resume::start(resume::quickHydrostatic(reference.path)) > 0, true);
+  int status = 0;
+  wait(&status);
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  const double delay = std::uniform_real_distribution<double>(
+      0.0, 2.0)(*std::make_unique<std::mt19937>(std::random_device{}()));
+  SCOPED_TRACE("killed " + std::to_string(delay) + " s into the loading");
+  ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::quickHydrostatic(killed.path)),
+                                        killed.path, delay));
+  EXPECT_EQ(resume::rows(killed.path, "SELECT status FROM runs"),
+            std::vector<std::string>{"running|"});
+  ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --threads 2 --lab " + killed.path, &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("resumes from unit"), std::string::npos) << out;
+  resume::expectSameRun(reference.path, killed.path);
+  // The completed run keeps no checkpoints and cannot be resumed again.
+  EXPECT_FALSE(std::filesystem::exists(killed.path + ".files/run-1/checkpoints"));
+  EXPECT_EQ(rocklab::testing::runRocklab("resume 1 --lab " + killed.path, &out), 2);
+  EXPECT_NE(out.find("completed: nothing to resume"), std::string::npos) << out;
+  std::filesystem::remove_all(reference.path + ".files");
+  std::filesystem::remove_all(killed.path + ".files");
+}
+
+// Killed twice in one run, the second time while it was resuming.
+TEST(Protocols, ARunKilledTwiceResumesToTheUninterruptedRun) {
+  Lab reference("twice-reference"), killed("twice-killed");
+  std::string out;
+  resume::start(resume::quickHydrostatic(reference.path));
+  int status = 0;
+  wait(&status);
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  std::mt19937 rng(std::random_device{}());
+  const double first = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+  const double second = std::uniform_real_distribution<double>(0.3, 1.5)(rng);
+  SCOPED_TRACE("killed " + std::to_string(first) + " s into the loading, then " +
+               std::to_string(second) + " s after resuming");
+  ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::quickHydrostatic(killed.path)),
+                                        killed.path, first));
+  const std::string mark = resume::rows(killed.path, "SELECT count(*) FROM series")[0];
+  const pid_t again =
+      resume::start({"resume", "1", "--quiet", "--threads", "1", "--lab", killed.path});
+  std::this_thread::sleep_for(std::chrono::duration<double>(second));
+  kill(again, SIGKILL);
+  waitpid(again, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the resumed run ended before it was killed";
+  ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --lab " + killed.path, &out), 0) << out;
+  resume::expectSameRun(reference.path, killed.path);
+  (void)mark;
+  std::filesystem::remove_all(reference.path + ".files");
+  std::filesystem::remove_all(killed.path + ".files");
+}
+
+// A run whose protocol or code changed since its checkpoint is refused with the reason.
+TEST(Protocols, ResumeRefusesAChangedProtocol) {
+  Lab lab("resume-refused");
+  std::string out;
+  ASSERT_TRUE(
+      resume::killDuringLoading(resume::start(resume::quickHydrostatic(lab.path)), lab.path, 0.0));
+  {
+    nb::Notebook n(lab.path);
+    n.db().exec("UPDATE runs SET protocol_text = protocol_text || '\n# edited' WHERE id = 1");
+  }
+  EXPECT_EQ(rocklab::testing::runRocklab("resume 1 --lab " + lab.path, &out), 2);
+  EXPECT_NE(out.find("the protocol changed since the checkpoint"), std::string::npos) << out;
+  {
+    nb::Notebook n(lab.path);
+    n.db().exec("UPDATE runs SET code_version = 'abc123' WHERE id = 1");
+  }
+  EXPECT_EQ(rocklab::testing::runRocklab("resume 1 --lab " + lab.path, &out), 2);
+  EXPECT_NE(out.find("it was made by rocklab abc123"), std::string::npos) << out;
+  std::filesystem::remove_all(lab.path + ".files");
 }
 
 namespace samples {
