@@ -255,9 +255,11 @@ TEST(Protocol, EffectiveTextReadsBackToTheSettingsWithTheOverridesMarked) {
             std::string::npos)
       << effective;
   const Settings back = parseProtocol("p.toml", effective, sc);
+  const auto back_table = back.table();
   for (const auto& row : s.table()) {
-    const auto it = std::find_if(back.table().begin(), back.table().end(),
+    const auto it = std::find_if(back_table.begin(), back_table.end(),
                                  [&](const auto& r) { return r.key == row.key; });
+    ASSERT_NE(it, back_table.end()) << row.key;
     EXPECT_EQ(it->value, row.value) << row.key;
   }
   EXPECT_EQ(back.real("numerics.local_damping"), 0.1234567890123);  // every bit
