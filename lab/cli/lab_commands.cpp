@@ -6,6 +6,7 @@
 #include <csignal>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "lab/cli/build_info.hpp"
 #include "lab/core/simulation.hpp"
@@ -172,10 +173,11 @@ class SkippedWhileReplaying : public rigs::Recorder {
   const rigs::RunControl& control_;
 };
 
-rigs::Journal::Options journalOptions(const protocol::Settings& settings) {
+rigs::Journal::Options journalOptions(const protocol::Settings& settings,
+                                      const std::string& protocol_text) {
   rigs::Journal::Options o;
   o.every_s = settings.real("output.checkpoint_every_s");
-  o.protocol_hash = notebook::hashText(settings.effectiveText());
+  o.protocol_hash = notebook::hashText(protocol_text);
   o.code_version = kGitRevision;
   return o;
 }
@@ -188,7 +190,9 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
   notebook::Notebook nb(lab);
   std::unique_ptr<notebook::RunWriter> writer;
   std::optional<rigs::Journal> journal;
-  rigs::Journal::Options jo = journalOptions(settings);
+  // The protocol as run (its text re-parsed to check it when keys were overridden): once.
+  const std::string protocol_text = settings.effectiveText();
+  rigs::Journal::Options jo = journalOptions(settings, protocol_text);
   if (resume_run > 0) {
     jo.dir = nb.runFilesDir(resume_run) + "/checkpoints";
     try {
@@ -202,7 +206,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
     notebook::RunInfo info;
     info.protocol = settings.text("protocol.name");
     info.protocol_file = std::filesystem::absolute(protocol_file).string();
-    info.protocol_text = settings.effectiveText();
+    info.protocol_text = protocol_text;
     info.rig = std::string(rig.name);
     info.code_version = kGitRevision;
     info.build_type = kBuildType;
@@ -275,21 +279,49 @@ int runProtocol(const RunOptions& o) {
   return runSettings(*c.rig, settings, o.protocol, o.lab, o.quiet).code;
 }
 
+namespace {
+
+// What the notebook kept of a run to run it again or continue it.
+struct StoredRun {
+  std::string file, text, version, status, host, pid;
+};
+
+StoredRun storedRun(notebook::Notebook& nb, std::int64_t run) {
+  notebook::requireRun(nb, run);
+  auto s = nb.db().prepare(
+      "SELECT protocol_file, protocol_text, code_version, status, host, pid FROM runs WHERE id = "
+      "?");
+  s.bind(1, run);
+  s.step();
+  return {s.text(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5)};
+}
+
+// The stored protocol checked again, with the command's --threads; none after saying why.
+std::optional<rigs::CheckedProtocol> recheck(std::int64_t run, const StoredRun& r,
+                                             const std::vector<protocol::Override>& overrides,
+                                             int threads) {
+  try {
+    rigs::CheckedProtocol c = rigs::checkProtocolText(r.file, r.text, overrides);
+    if (threads > 0) c.settings.override("numerics.threads", static_cast<std::int64_t>(threads));
+    return c;
+  } catch (const protocol::ProtocolError& e) {
+    std::cerr << "run " << run << "'s protocol (" << r.file << "):\n" << e.what() << "\n";
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
 int rerunProtocol(std::int64_t run, const RunOptions& o) {
   if (!std::filesystem::exists(o.lab)) {
     std::cerr << "no lab notebook at '" << o.lab << "' (--lab PATH)\n";
     return 2;
   }
-  std::string file, text, version;
+  StoredRun r;
   std::vector<protocol::Override> overrides = overridesOf(o.sets);
   {
     notebook::Notebook nb(o.lab);
-    notebook::requireRun(nb, run);
-    auto s =
-        nb.db().prepare("SELECT protocol_file, protocol_text, code_version FROM runs WHERE id = ?");
-    s.bind(1, run);
-    s.step();
-    file = s.text(0), text = s.text(1), version = s.text(2);
+    r = storedRun(nb, run);
     // A file the run read that is gone or changed since: the notebook's copy stands in.
     auto in = nb.db().prepare("SELECT key, path, sha256, copy FROM inputs WHERE run_id = ?");
     in.bind(1, run);
@@ -304,21 +336,14 @@ int rerunProtocol(std::int64_t run, const RunOptions& o) {
       overrides.insert(overrides.begin(), {in.text(0), "\"" + copy + "\"", "rerun"});
     }
   }
-  if (version != kGitRevision) {
-    std::cerr << "warning: run " << run << " was made by rocklab " << version << ", this is "
+  if (r.version != kGitRevision) {
+    std::cerr << "warning: run " << run << " was made by rocklab " << r.version << ", this is "
               << kGitRevision << ": results may differ where the code changed\n";
   }
-  rigs::CheckedProtocol c{nullptr, {}};
-  try {
-    c = rigs::checkProtocolText(file, text, overrides);
-  } catch (const protocol::ProtocolError& e) {
-    std::cerr << "run " << run << "'s protocol (" << file << "):\n" << e.what() << "\n";
-    return 2;
-  }
-  protocol::Settings settings = c.settings;
-  if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+  const auto c = recheck(run, r, overrides, o.threads);
+  if (!c) return 2;
   std::cerr << "rerun of run " << run << "\n";
-  return runSettings(*c.rig, settings, file, o.lab, o.quiet).code;
+  return runSettings(*c->rig, c->settings, r.file, o.lab, o.quiet).code;
 }
 
 int resumeRun(std::int64_t run, const RunOptions& o) {
@@ -326,47 +351,33 @@ int resumeRun(std::int64_t run, const RunOptions& o) {
     std::cerr << "no lab notebook at '" << o.lab << "' (--lab PATH)\n";
     return 2;
   }
-  std::string file, text, version, status;
+  StoredRun r;
   {
     notebook::Notebook nb(o.lab);  // a run left running by a dead process is failed from here
-    notebook::requireRun(nb, run);
-    auto s = nb.db().prepare(
-        "SELECT protocol_file, protocol_text, code_version, status, host, pid FROM runs WHERE "
-        "id = ?");
-    s.bind(1, run);
-    s.step();
-    file = s.text(0), text = s.text(1), version = s.text(2), status = s.text(3);
-    if (status == "completed") {
-      std::cerr << "run " << run << " is completed: nothing to resume (rocklab rerun " << run
-                << " runs it again)\n";
-      return 2;
-    }
-    if (status == "running") {
-      std::cerr << "run " << run << " is still running (pid " << s.text(5) << " on " << s.text(4)
-                << ")\n";
-      return 2;
-    }
+    r = storedRun(nb, run);
   }
-  if (version != kGitRevision) {
-    std::cerr << "run " << run << " cannot resume: it was made by rocklab " << version
+  if (r.status == "completed") {
+    std::cerr << "run " << run << " is completed: nothing to resume (rocklab rerun " << run
+              << " runs it again)\n";
+    return 2;
+  }
+  if (r.status == "running") {
+    std::cerr << "run " << run << " is still running (pid " << r.pid << " on " << r.host << ")\n";
+    return 2;
+  }
+  if (r.version != kGitRevision) {
+    std::cerr << "run " << run << " cannot resume: it was made by rocklab " << r.version
               << ", this is " << kGitRevision
               << ": only the same code continues a run bit for bit\n";
     return 2;
   }
-  rigs::CheckedProtocol c{nullptr, {}};
-  try {
-    c = rigs::checkProtocolText(file, text);
-  } catch (const protocol::ProtocolError& e) {
-    std::cerr << "run " << run << "'s protocol (" << file << "):\n" << e.what() << "\n";
+  const auto c = recheck(run, r, {}, o.threads);
+  if (!c) return 2;
+  if (!c->rig->not_resumable.empty()) {
+    std::cerr << "run " << run << " cannot resume: " << c->rig->not_resumable << "\n";
     return 2;
   }
-  if (!c.rig->not_resumable.empty()) {
-    std::cerr << "run " << run << " cannot resume: " << c.rig->not_resumable << "\n";
-    return 2;
-  }
-  protocol::Settings settings = c.settings;
-  if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
-  return runSettings(*c.rig, settings, file, o.lab, o.quiet, run).code;
+  return runSettings(*c->rig, c->settings, r.file, o.lab, o.quiet, run).code;
 }
 
 int notebookCommand(const NotebookOptions& o) {

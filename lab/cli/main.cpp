@@ -216,44 +216,44 @@ void addSet(CLI::App* command, std::vector<std::string>& sets) {
       ->allow_extra_args(false);
 }
 
+// The options every command that runs a protocol takes.
+void addRunOptions(CLI::App* command, rocklab::cli::RunOptions& o, const std::string& lab_doc) {
+  command->add_option("--lab", o.lab, lab_doc);
+  command->add_flag("--quiet", o.quiet, "No progress on stderr");
+  command->add_option("--threads", o.threads, "Threads, instead of numerics.threads (same results)")
+      ->check(CLI::Range(1, 1024));
+}
+
 void addRun(CLI::App& app, Action& action) {
   auto o = std::make_shared<rocklab::cli::RunOptions>();
   auto* r = app.add_subcommand("run", "Run a protocol; every measurement goes to the lab notebook");
   r->add_option("protocol", o->protocol, "Protocol file (TOML)")
       ->required()
       ->check(CLI::ExistingFile);
-  r->add_option("--lab", o->lab, "Lab notebook (SQLite), created if missing");
-  r->add_flag("--quiet", o->quiet, "No progress on stderr");
-  r->add_option("--threads", o->threads, "Threads, instead of numerics.threads (same results)")
-      ->check(CLI::Range(1, 1024));
+  addRunOptions(r, *o, "Lab notebook (SQLite), created if missing");
   addSet(r, o->sets);
   r->callback([&action, o] { action = [o] { return rocklab::cli::runProtocol(*o); }; });
 
-  auto ro = std::make_shared<rocklab::cli::RunOptions>();
-  auto run = std::make_shared<std::int64_t>(0);
-  auto* rr = app.add_subcommand(
-      "rerun", "Run a run of the notebook again, from the protocol text the notebook kept");
-  rr->add_option("run", *run, "Run id")->required();
-  rr->add_option("--lab", ro->lab, "Lab notebook (SQLite); the new run goes there too");
-  rr->add_flag("--quiet", ro->quiet, "No progress on stderr");
-  rr->add_option("--threads", ro->threads, "Threads (same results)")->check(CLI::Range(1, 1024));
-  addSet(rr, ro->sets);
-  rr->callback([&action, ro, run] {
-    action = [ro, run] { return rocklab::cli::rerunProtocol(*run, *ro); };
-  });
-
-  auto so = std::make_shared<rocklab::cli::RunOptions>();
-  auto srun = std::make_shared<std::int64_t>(0);
-  auto* rs = app.add_subcommand(
-      "resume",
-      "Continue a run that was killed, interrupted or stopped from its last checkpoint, in the "
-      "same notebook row: it ends as an uninterrupted run would");
-  rs->add_option("run", *srun, "Run id")->required();
-  rs->add_option("--lab", so->lab, "Lab notebook (SQLite)");
-  rs->add_flag("--quiet", so->quiet, "No progress on stderr");
-  rs->add_option("--threads", so->threads, "Threads (same results)")->check(CLI::Range(1, 1024));
-  rs->callback(
-      [&action, so, srun] { action = [so, srun] { return rocklab::cli::resumeRun(*srun, *so); }; });
+  // rerun and resume: a run of the notebook, again or continued.
+  using RunOf = int (*)(std::int64_t, const rocklab::cli::RunOptions&);
+  auto addRunOf = [&](const char* name, const char* doc, const char* lab_doc, RunOf command,
+                      bool with_set) {
+    auto ro = std::make_shared<rocklab::cli::RunOptions>();
+    auto run = std::make_shared<std::int64_t>(0);
+    auto* c = app.add_subcommand(name, doc);
+    c->add_option("run", *run, "Run id")->required();
+    addRunOptions(c, *ro, lab_doc);
+    if (with_set) addSet(c, ro->sets);
+    c->callback([&action, ro, run, command] {
+      action = [ro, run, command] { return command(*run, *ro); };
+    });
+  };
+  addRunOf("rerun", "Run a run of the notebook again, from the protocol text the notebook kept",
+           "Lab notebook (SQLite); the new run goes there too", &rocklab::cli::rerunProtocol, true);
+  addRunOf("resume",
+           "Continue a run that was killed, interrupted or stopped from its last checkpoint, in "
+           "the same notebook row: it ends as an uninterrupted run would",
+           "Lab notebook (SQLite)", &rocklab::cli::resumeRun, false);
 }
 
 void addCheckAndKeys(CLI::App& app, Action& action) {

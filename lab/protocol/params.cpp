@@ -20,29 +20,40 @@ std::string number(double v) {
   return Range::formatNumber(v);
 }
 
-std::string show(const Value& v) {
+// A value as text: numbers by `real`, a text by `text`, the texts of a list by `listed`.
+template <class Real, class Text, class Listed>
+std::string render(const Value& v, Real real, Text text, Listed listed) {
   return std::visit(
-      [](const auto& x) -> std::string {
+      [&](const auto& x) -> std::string {
         using T = std::decay_t<decltype(x)>;
         if constexpr (std::is_same_v<T, double>) {
-          return number(x);
+          return real(x);
         } else if constexpr (std::is_same_v<T, std::int64_t>) {
           return std::to_string(x);
         } else if constexpr (std::is_same_v<T, std::string>) {
-          return x;
+          return text(x);
         } else if constexpr (std::is_same_v<T, bool>) {
           return x ? "true" : "false";
-        } else if constexpr (std::is_same_v<T, std::vector<double>>) {
-          std::string s = "[";
-          for (std::size_t k = 0; k < x.size(); ++k) s += (k ? ", " : "") + number(x[k]);
-          return s + "]";
         } else {
-          std::string s = "[";
-          for (std::size_t k = 0; k < x.size(); ++k) s += (k ? ", \"" : "\"") + x[k] + "\"";
-          return s + "]";
+          std::string t = "[";
+          for (std::size_t k = 0; k < x.size(); ++k) {
+            if constexpr (std::is_same_v<T, std::vector<double>>) {
+              t += (k ? ", " : "") + real(x[k]);
+            } else {
+              t += (k ? ", " : "") + listed(x[k]);
+            }
+          }
+          return t + "]";
         }
       },
       v);
+}
+
+// As `rocklab keys` and the notebook's parameters show it (10 significant digits).
+std::string show(const Value& v) {
+  return render(
+      v, number, [](const std::string& t) { return t; },
+      [](const std::string& t) { return "\"" + t + "\""; });
 }
 
 std::size_t editDistance(const std::string& a, const std::string& b) {
@@ -491,30 +502,7 @@ std::string tomlLiteral(const Value& v) {
     }
     return q + "\"";
   };
-  return std::visit(
-      [&](const auto& x) -> std::string {
-        using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, double>) {
-          return real(x);
-        } else if constexpr (std::is_same_v<T, std::int64_t>) {
-          return std::to_string(x);
-        } else if constexpr (std::is_same_v<T, std::string>) {
-          return quoted(x);
-        } else if constexpr (std::is_same_v<T, bool>) {
-          return x ? "true" : "false";
-        } else {
-          std::string t = "[";
-          for (std::size_t k = 0; k < x.size(); ++k) {
-            if constexpr (std::is_same_v<T, std::vector<double>>) {
-              t += (k ? ", " : "") + real(x[k]);
-            } else {
-              t += (k ? ", " : "") + quoted(x[k]);
-            }
-          }
-          return t + "]";
-        }
-      },
-      v);
+  return render(v, real, quoted, quoted);
 }
 
 std::vector<std::string> splitLines(const std::string& text) {

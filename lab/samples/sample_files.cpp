@@ -1,6 +1,7 @@
 #include "lab/samples/sample_files.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
@@ -9,28 +10,13 @@
 
 namespace rocklab {
 
-const char* sampleFormatName(SampleFormat f) {
-  switch (f) {
-    case SampleFormat::Auto:
-      return "auto";
-    case SampleFormat::Rocklab:
-      return "rocklab";
-    case SampleFormat::Csv:
-      return "csv";
-    case SampleFormat::Lammps:
-      return "lammps";
-    case SampleFormat::Yade:
-      return "yade";
-    case SampleFormat::Vtp:
-      return "vtp";
-  }
-  return "auto";
+std::string sample_formats::lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
 }
 
 SampleFormat sampleFormatOf(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = sample_formats::lower(std::filesystem::path(path).extension().string());
   if (ext == ".csv") return SampleFormat::Csv;
   if (ext == ".data" || ext == ".lmp" || ext == ".lammps") return SampleFormat::Lammps;
   if (ext == ".vtp") return SampleFormat::Vtp;

@@ -17,9 +17,8 @@ namespace rocklab {
 
 enum class SampleFormat { Auto, Rocklab, Csv, Lammps, Yade, Vtp };
 
-// A format's protocol name ("csv") and back; Auto picks by the file's extension.
-const char* sampleFormatName(SampleFormat f);
-SampleFormat sampleFormatOf(const std::string& path);  // by extension; throws when unknown
+// The format of a file by its extension; throws naming the extensions when it is unknown.
+SampleFormat sampleFormatOf(const std::string& path);
 
 // What a file holds, in metres, before it becomes a packing of a dimension.
 struct SampleFileData {
@@ -41,6 +40,7 @@ Packing<D> samplePacking(const SampleFileData& data, const std::string& path);
 
 // The readers behind readSampleFile, one per format.
 namespace sample_formats {
+std::string lower(std::string s);  // ASCII lower case: names in headers, extensions
 SampleFileData readCsv(const std::string& path, double unit);
 SampleFileData readLammps(const std::string& path, double unit);
 SampleFileData readYade(const std::string& path, double unit);

@@ -19,11 +19,6 @@ namespace rocklab::sample_formats {
 
 namespace {
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 // VTK prints its parse errors and carries on with an empty output: the file is checked to
 // be VTK XML PolyData first, so that the error says what was expected.
 void checkHeader(const std::string& path) {
