@@ -29,9 +29,7 @@ const std::vector<RigEntry>& rigTable() {
           "permeameter",
           "permeameter: pore fluid driven through the sample between fixed end pressures, "
           "steady flow every n steps, Darcy permeability under hydrostatic or biaxial / "
-          "triaxial loading",
-          "the pore fluid's state (its network and pressures) is not in the checkpoints yet, so "
-          "a resumed run would not end as an uninterrupted one; run it again"),
+          "triaxial loading"),
       rigEntry<ultrasonic::Settings, ultrasonic::run>(
           "ultrasonic",
           "ultrasonic bench: P and S waves (pz, px, szx, sxy) through copies of a sample at "
@@ -106,6 +104,27 @@ CheckedProtocol checkProtocolText(const std::string& path, const std::string& te
   CheckedProtocol c{&rig, protocol::parseProtocol(path, text, schemaOf(rig), overrides)};
   validateProtocol(rig, c.settings);
   return c;
+}
+
+std::vector<std::string> unusedKeys(const protocol::Settings& s) {
+  std::vector<std::string> out;
+  const std::string& kind = s.text("sample.kind");
+  for (const notebook::ParamRow& row : s.table()) {
+    const std::string& key = row.key;
+    if (!s.given(key)) continue;
+    const bool of_file = key.starts_with("sample.file") || key == "sample.format";
+    const bool of_generator = key.starts_with("grains.") || key.starts_with("clumps.") ||
+                              (key.starts_with("sample.") && !of_file && key != "sample.kind" &&
+                               key != "sample.thickness_m");
+    if (kind == "file" && of_generator) {
+      out.push_back(s.where(key) + ": " + key +
+                    " is not used: the sample is read from sample.file (kind = file)");
+    } else if (kind != "file" && of_file) {
+      out.push_back(s.where(key) + ": " + key + " is not used: sample.kind is " + kind +
+                    ", not file");
+    }
+  }
+  return out;
 }
 
 void validateProtocol(const RigEntry& rig, const protocol::Settings& s) {

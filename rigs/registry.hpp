@@ -17,8 +17,6 @@ namespace rocklab::rigs {
 struct RigEntry {
   std::string_view name;
   std::string_view doc;
-  // Why a run of this rig cannot be resumed from its checkpoints; empty when it can.
-  std::string_view not_resumable;
   void (*declare)(protocol::Schema&);
   // Reads the settings into the rig's struct, which checks its rules across keys (throws
   // protocol::ProtocolError).
@@ -29,12 +27,8 @@ struct RigEntry {
 
 // A row for a rig whose settings are `S` and whose run is `Run`.
 template <class S, void (*Run)(const S&, Recorder&, RunControl&)>
-RigEntry rigEntry(std::string_view name, std::string_view doc,
-                  std::string_view not_resumable = {}) {
-  return {name,
-          doc,
-          not_resumable,
-          [](protocol::Schema& s) { protocol::declare<S>(s); },
+RigEntry rigEntry(std::string_view name, std::string_view doc) {
+  return {name, doc, [](protocol::Schema& s) { protocol::declare<S>(s); },
           [](const protocol::Settings& s) { (void)protocol::read<S>(s); },
           [](const protocol::Settings& s, Recorder& rec, RunControl& control) {
             Run(protocol::read<S>(s), rec, control);
@@ -61,5 +55,8 @@ CheckedProtocol checkProtocolText(const std::string& path, const std::string& te
                                   const std::vector<protocol::Override>& overrides = {});
 // The checks across keys again, after values were replaced (a study's settings).
 void validateProtocol(const RigEntry& rig, const protocol::Settings& s);
+// The keys a protocol gives that its run does not read (the generator's keys of a sample
+// read from a file), each as a warning naming where it was given.
+std::vector<std::string> unusedKeys(const protocol::Settings& s);
 
 }  // namespace rocklab::rigs

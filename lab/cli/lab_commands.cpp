@@ -102,6 +102,7 @@ int checkProtocol(const std::string& path, const std::vector<std::string>& sets)
       ++total;
       given += c.settings.given(row.key);
     }
+    for (const std::string& w : rigs::unusedKeys(c.settings)) std::cerr << "warning: " << w << "\n";
     std::cout << path << ": a valid " << c.rig->name << " protocol (" << given << " keys set, "
               << total - given << " defaults)\n";
     return 0;
@@ -223,8 +224,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   rigs::RunControl control(!quiet && isatty(STDERR_FILENO), interruption);
-  // A rig that cannot resume writes no checkpoints (they would promise what it cannot keep).
-  if (rig.not_resumable.empty()) control.setJournal(&*journal);
+  control.setJournal(&*journal);
   NotebookRecorder notebook_rec(*writer);
   SkippedWhileReplaying replay_rec(notebook_rec, control);
   rigs::CheckedRecorder rec(replay_rec, rig.outputs(), std::string(rig.name));
@@ -241,6 +241,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
     rec.stageTiming("checkpoints", journal->writeSeconds(), journal->writes());
   };
   try {
+    for (const std::string& w : rigs::unusedKeys(settings)) rec.message(0, 0.0, "warning", w);
     rig.run(settings, rec, control);
     control.done();
     checkpointTime();
@@ -373,10 +374,6 @@ int resumeRun(std::int64_t run, const RunOptions& o) {
   }
   const auto c = recheck(run, r, {}, o.threads);
   if (!c) return 2;
-  if (!c->rig->not_resumable.empty()) {
-    std::cerr << "run " << run << " cannot resume: " << c->rig->not_resumable << "\n";
-    return 2;
-  }
   return runSettings(*c->rig, c->settings, r.file, o.lab, o.quiet, run).code;
 }
 

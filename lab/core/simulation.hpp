@@ -280,8 +280,8 @@ class Simulation {
   void saveCheckpoint(const std::string& path) const;
   static Simulation loadCheckpoint(const std::string& path);
   // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle and moment_factor,
-  // 5 config.skin_ratio.
-  static constexpr std::uint32_t kCheckpointVersion = 5;
+  // 5 config.skin_ratio, 6 the applied forces.
+  static constexpr std::uint32_t kCheckpointVersion = 6;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };

@@ -160,6 +160,7 @@ void Simulation<D>::visit(Archive& ar) {
   ar("time", time_), ar("dt", dt_), ar("step", step_), ar("kinetic", kinetic_);
   ar("forces_valid", forces_valid_);
   ar("damp_force", damp_force_), ar("damp_torque", damp_torque_);
+  ar("applied", applied_);
 }
 
 template <int D>

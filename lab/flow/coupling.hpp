@@ -75,6 +75,15 @@ struct FlowReading {
   double critical_step = 0.0;      // s, equation 6 on the clusters
   SteadyFlow solve;                // the last solve (pressures per cluster, cost)
   double network_seconds = 0.0;    // triangulation and measurement of this update
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("permeability", permeability), ar("inflow", inflow), ar("outflow", outflow);
+    ar("length", length), ar("area", area), ar("pores", pores), ar("pipes", pipes);
+    ar("clusters", clusters), ar("cluster_pipes", cluster_pipes), ar("hidden", hidden);
+    ar("isolated", isolated), ar("triangulations", triangulations);
+    ar("critical_step", critical_step), ar("solve", solve);
+    ar("network_seconds", network_seconds);
+  }
 };
 
 template <int D>
@@ -112,6 +121,29 @@ class FlowCoupling {
   const std::vector<PoreBoundary>& poreBoundary() const { return boundary_; }
   // Mean particle radius of the pack (m).
   double meanRadius() const { return mean_radius_; }
+
+  // What the coupling carries from one update to the next, for checkpoints: the network
+  // and where it was built, the last pressures (the next solve starts from them), a
+  // calibrated alpha.
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("alpha", settings_.law.alpha);
+    bool has_network = network_.has_value();
+    ar("has_network", has_network);
+    if constexpr (Archive::kReading) {
+      if (has_network) {
+        network_.emplace();
+      } else {
+        network_.reset();
+      }
+    }
+    if (has_network) ar("network", *network_);
+    ar("slots", slots_), ar("built_at", built_at_), ar("pack", pack_);
+    ar("boundary", boundary_), ar("pore_pressure", pore_pressure_), ar("clusters", clusters_);
+    ar("mean_radius", mean_radius_), ar("inlet_level", inlet_level_);
+    ar("outlet_level", outlet_level_), ar("last_permeability", last_permeability_);
+    ar("triangulations", triangulations_), ar("hidden", hidden_);
+  }
 
  private:
   PackView<D> pack(const Simulation<D>& sim) const;

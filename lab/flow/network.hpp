@@ -23,6 +23,10 @@ struct PackView {
   std::vector<double> radius;
   std::vector<std::array<std::uint32_t, 2>> bond;
   std::vector<double> bond_radius;
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("centre", centre), ar("radius", radius), ar("bond", bond), ar("bond_radius", bond_radius);
+  }
 };
 
 // Which pores have their pressure imposed.
@@ -49,6 +53,8 @@ class Network {
   // areas times it, and the permeability's cross-section is the width times it (a 2D pack
   // is one layer of grains, each pipe one throat of that layer; ignored in 3D).
   Network(Triangulation<D> topology, double slice);
+  // An empty network for a checkpoint to be read into (visit).
+  Network() : slice_(0.0) {}
 
   // Measures every pore and pipe on `pack` (the same particles, in the same order, as the
   // triangulation was built on).
@@ -86,6 +92,16 @@ class Network {
   std::vector<V> particleForces(const std::vector<double>& pore_pressure, const PackView<D>& pack,
                                 double thickness) const;
 
+  // The network as built and last measured, for checkpoints (a resumed run goes on with the
+  // same triangulation: triangulating anew would not be the uninterrupted run).
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("topology", topology_), ar("slice", slice_), ar("pipe_a", pipe_a_), ar("pipe_b", pipe_b_);
+    ar("pipe_facet", pipe_facet_), ar("volume", volume_), ar("throat", throat_);
+    ar("conductance", conductance_), ar("centroid", centroid_);
+    ar("worst_quality", worst_quality_);
+  }
+
  private:
   Triangulation<D> topology_;
   double slice_;
@@ -105,6 +121,11 @@ struct Clusters {
   std::vector<double> edge_conductance;
   std::vector<double> volume;          // m^3 per cluster
   std::vector<PoreBoundary> boundary;  // per cluster: imposed if any of its pores is
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("of_pore", of_pore), ar("count", count), ar("edge_a", edge_a), ar("edge_b", edge_b);
+    ar("edge_conductance", edge_conductance), ar("volume", volume), ar("boundary", boundary);
+  }
 };
 
 struct MergeRule {

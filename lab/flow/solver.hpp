@@ -43,6 +43,12 @@ struct SteadyFlow {
   double seconds = 0.0;      // wall time of the solve
   std::size_t isolated = 0;  // clusters with no conducting path to a boundary
   double dt = 0.0;           // s, the explicit step used (0 for implicit)
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("pressure", pressure), ar("inflow", inflow), ar("outflow", outflow);
+    ar("iterations", iterations), ar("residual", residual), ar("converged", converged);
+    ar("seconds", seconds), ar("isolated", isolated), ar("dt", dt);
+  }
 };
 
 // The critical explicit step (s) over the free clusters: min v / (K_f sum C).

@@ -37,6 +37,10 @@ struct Triangulation {
   std::vector<std::array<std::int32_t, D + 1>> neighbours;
   std::size_t hidden = 0;   // input points that got no vertex (inside their neighbours)
   std::size_t trimmed = 0;  // cells removed by trimHull
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("cells", cells), ar("neighbours", neighbours), ar("hidden", hidden), ar("trimmed", trimmed);
+  }
 };
 
 // Throws DegenerateNetwork for input that spans less than D dimensions.

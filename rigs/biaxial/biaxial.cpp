@@ -60,6 +60,10 @@ struct LoadingHistory {
     std::uint64_t step = 0;
     double time = 0.0;
     std::vector<std::array<double, 3>> positions;
+    template <class Archive>
+    void visit(Archive& ar) {
+      ar("strain", strain), ar("step", step), ar("time", time), ar("positions", positions);
+    }
   };
   std::uint64_t start_step = 0;
   std::size_t bond_breaks_before = 0, clumps_broken_before = 0;  // the logs' lengths at the start
@@ -70,6 +74,16 @@ struct LoadingHistory {
   std::vector<State> states;
   double meanUnbalanced() const {
     return unbalanced_sum / static_cast<double>(std::max<std::size_t>(1, curve.q.size()));
+  }
+  // The loop's state in a checkpoint (rigs/common/journal.hpp).
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("start_step", start_step), ar("bond_breaks_before", bond_breaks_before);
+    ar("clumps_broken_before", clumps_broken_before), ar("peak", peak);
+    ar("peak_strain", peak_strain), ar("peak_volumetric", peak_volumetric);
+    ar("peak_axial", peak_axial), ar("confining_error", confining_error);
+    ar("unbalanced_sum", unbalanced_sum), ar("inertial_max", inertial_max);
+    ar("curve", curve), ar("breaks_at", breaks_at), ar("states", states);
   }
 };
 
@@ -100,6 +114,8 @@ LoadingHistory loadAxially(Specimen<D>& sp, const LoadingTest& test, double sigm
   const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
   const auto snapshot_every = static_cast<std::uint64_t>(sp.settings.output.snapshot_every_steps);
   LoadingHistory h;
+  Journal::Unit unit = control.unit(n.stage);
+  if (unit.done(h, sp)) return h;
   h.bond_breaks_before = sim.bondBreaks().size();
   h.clumps_broken_before = sim.clumpBreaks().size();
   frame.set(ax, Axis{Mode::StrainRate, rate});
@@ -109,8 +125,9 @@ LoadingHistory loadAxially(Specimen<D>& sp, const LoadingTest& test, double sigm
   h.states.push_back({0.0, sim.steps(), sim.time(), slotPositions(sim)});
   // A confinement below 1 MPa is judged against 1 MPa: at zero the walls just keep clear.
   const double error_scale = std::max(sigma3, 1e6);
-  bool done = false;
-  while (!done) {
+  unit.resume(h, sp);
+  for (bool done = false; !done;) {
+    unit.tick(h, sp);  // before the step: the loop goes on from a checkpoint's state
     frame.step();
     const std::uint64_t steps = sim.steps() - h.start_step;
     const double strain = frame.strain(ax);
@@ -152,6 +169,7 @@ LoadingHistory loadAxially(Specimen<D>& sp, const LoadingTest& test, double sigm
   }
   snapshot(sp, rec, n.stage, "final");
   h.states.push_back({frame.strain(ax), sim.steps(), sim.time(), slotPositions(sim)});
+  unit.finish(h, sp);
   return h;
 }
 

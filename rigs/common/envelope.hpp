@@ -13,6 +13,10 @@ namespace rocklab::rigs {
 // volumetric strain (compaction positive), sampled at the same instants.
 struct LoadingCurve {
   std::vector<double> axial_strain, q, volumetric_strain;
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("axial_strain", axial_strain), ar("q", q), ar("volumetric_strain", volumetric_strain);
+  }
 };
 
 struct CriticalPoint {

@@ -8,9 +8,20 @@
 #include <array>
 #include <functional>
 
+#include "lab/core/archive.hpp"
 #include "lab/core/simulation.hpp"
 
 namespace rocklab::rigs {
+
+// What a coupled effect keeps from one call to the next (a pore fluid's network and its
+// pressures): checkpointed with the frame, so that a resumed run continues the effect as an
+// uninterrupted one would.
+class CoupledState {
+ public:
+  virtual ~CoupledState() = default;
+  virtual void save(ArchiveWriter& ar) = 0;
+  virtual void load(ArchiveReader& ar) = 0;
+};
 
 template <int D>
 class LoadingFrame {
@@ -37,18 +48,30 @@ class LoadingFrame {
   void attach(Simulation<D>& sim) {
     sim_ = &sim;
     effect_ = nullptr;
+    coupled_state_ = nullptr;
   }
   // A frame read back from a checkpoint (visit) around a simulation read back with it: its
   // walls are already the simulation's.
   struct Restored {};
   LoadingFrame(Simulation<D>& sim, Restored) : sim_(&sim) {}
   // The frame's own state, for checkpoints (the walls are the simulation's; a coupled effect
-  // is set again by the rig).
+  // is set again by the rig, its state read back into it).
   template <class Archive>
   void visit(Archive& ar) {
     ar("axes", axes_), ar("reference", reference_), ar("solid_volume", solid_volume_);
     ar("servo_alpha", servo_alpha_), ar("servo_max_speed", servo_max_speed_);
     ar("effect_interval", effect_interval_);
+    bool coupled = coupled_state_ != nullptr;
+    ar("coupled_state", coupled);
+    if (!coupled) return;
+    if constexpr (Archive::kReading) {
+      if (!coupled_state_) {
+        throw CheckpointError("the checkpoint holds a coupled effect's state the rig has not set");
+      }
+      coupled_state_->load(ar);
+    } else {
+      coupled_state_->save(ar);
+    }
   }
 
   void set(int axis, const Axis& a);
@@ -61,10 +84,12 @@ class LoadingFrame {
   void step();
   // An effect that acts before every step whose number is a multiple of `interval`: a
   // coupled pore fluid solved to steady state and applied to the particles (Li & Holt
-  // section 3.5.2: every n particle steps). An empty function removes it.
-  void couple(std::function<void()> effect, std::uint64_t interval) {
+  // section 3.5.2: every n particle steps). An empty function removes it. `state`, if the
+  // effect keeps one, goes into the frame's checkpoints.
+  void couple(std::function<void()> effect, std::uint64_t interval, CoupledState* state = nullptr) {
     effect_ = std::move(effect);
     effect_interval_ = std::max<std::uint64_t>(interval, 1);
+    coupled_state_ = effect_ ? state : nullptr;
   }
 
   Simulation<D>& sim() { return *sim_; }
@@ -93,6 +118,7 @@ class LoadingFrame {
   double servo_max_speed_ = 0.0;
   std::function<void()> effect_;
   std::uint64_t effect_interval_ = 1;
+  CoupledState* coupled_state_ = nullptr;
 };
 
 }  // namespace rocklab::rigs

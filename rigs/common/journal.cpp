@@ -62,6 +62,10 @@ Journal Journal::resuming(Options o) {
   j.replaying_ = true;
   j.resume_unit_ = std::stoi(m["unit"]);
   j.resume_phase_ = m["phase"] == "mid" ? Phase::Mid : Phase::End;
+  j.resume_seq_ = std::stoull(m["seq"].empty() ? "0" : m["seq"]);
+  j.seq_ = j.resume_seq_;  // the resumed run numbers its checkpoints on
+  if (j.resume_phase_ == Phase::Mid)
+    j.last_mid_ = j.file(j.resume_unit_, Phase::Mid, j.resume_seq_);
   j.resume_mark_ = m["mark"];
   j.resume_point_ = "unit " + m["unit"] + " (" + m["name"] + "), " + m["phase"];
   return j;
@@ -71,10 +75,10 @@ Journal::Unit Journal::begin(std::string_view name) {
   return Unit(this, ordinal_++, std::string(name));
 }
 
-std::string Journal::file(int ordinal, Phase phase) const {
-  return (fs::path(o_.dir) /
-          ("unit-" + std::to_string(ordinal) + (phase == Phase::End ? ".end" : ".mid")))
-      .string();
+std::string Journal::file(int ordinal, Phase phase, std::uint64_t seq) const {
+  const std::string name = "unit-" + std::to_string(ordinal) +
+                           (phase == Phase::End ? ".end" : ".mid-" + std::to_string(seq));
+  return (fs::path(o_.dir) / name).string();
 }
 
 void Journal::write(int ordinal, Phase phase, std::string_view name, const std::string& bytes) {
@@ -87,23 +91,30 @@ void Journal::write(int ordinal, Phase phase, std::string_view name, const std::
   data.append(reinterpret_cast<const char*>(&n), sizeof n);
   data.append(name);
   data += bytes;
-  writeAtomically(file(ordinal, phase), data);
+  // The checkpoint first, under a name of its own; the manifest's rename then makes it the
+  // one to resume from, with the notebook mark taken with it. A kill between the two leaves
+  // the manifest naming the previous checkpoint, which is still there.
+  const std::uint64_t seq = ++seq_;
+  const std::string path = file(ordinal, phase, seq);
+  writeAtomically(path, data);
   std::ostringstream manifest;
-  manifest << "unit " << ordinal << "\nphase " << (phase == Phase::End ? "end" : "mid") << "\nname "
-           << name << "\nprotocol " << o_.protocol_hash << "\ncode " << o_.code_version << "\nmark "
-           << mark << "\n";
+  manifest << "unit " << ordinal << "\nphase " << (phase == Phase::End ? "end" : "mid") << "\nseq "
+           << seq << "\nname " << name << "\nprotocol " << o_.protocol_hash << "\ncode "
+           << o_.code_version << "\nmark " << mark << "\n";
   writeAtomically(fs::path(o_.dir) / "journal", manifest.str());
-  if (phase == Phase::End) fs::remove(file(ordinal, Phase::Mid));
+  if (!last_mid_.empty()) fs::remove(last_mid_);
+  last_mid_ = phase == Phase::Mid ? path : std::string();
   write_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++writes_;
 }
 
 std::string Journal::read(int ordinal, Phase phase, std::string_view name) const {
-  const std::string data = readAll(file(ordinal, phase));
+  const std::string path = file(ordinal, phase, phase == Phase::Mid ? resume_seq_ : 0);
+  const std::string data = readAll(path);
   std::uint64_t n = 0;
   if (data.size() < sizeof kMagic + sizeof n ||
       data.compare(0, sizeof kMagic, kMagic, sizeof kMagic) != 0) {
-    throw std::runtime_error("'" + file(ordinal, phase) + "' is not a rocklab run checkpoint");
+    throw std::runtime_error("'" + path + "' is not a rocklab run checkpoint");
   }
   std::memcpy(&n, data.data() + sizeof kMagic, sizeof n);
   const std::string stored = data.substr(sizeof kMagic + sizeof n, n);

@@ -58,7 +58,9 @@ class Journal {
  private:
   friend class Unit;
   enum class Phase { End, Mid };
-  std::string file(int ordinal, Phase phase) const;
+  // A unit's end checkpoint; the mid checkpoints of a unit are numbered by the journal's
+  // writes, so that a new one never replaces the one the manifest still names.
+  std::string file(int ordinal, Phase phase, std::uint64_t seq = 0) const;
   void write(int ordinal, Phase phase, std::string_view name, const std::string& bytes);
   std::string read(int ordinal, Phase phase, std::string_view name) const;
   Options o_;
@@ -66,6 +68,9 @@ class Journal {
   bool replaying_ = false;
   int resume_unit_ = -1;  // the unit the checkpoint is of
   Phase resume_phase_ = Phase::End;
+  std::uint64_t resume_seq_ = 0;  // its number
+  std::uint64_t seq_ = 0;         // the number of the last checkpoint written
+  std::string last_mid_;          // the mid checkpoint the manifest names, if any
   std::string resume_mark_, resume_point_;
   double write_seconds_ = 0.0;
   std::uint64_t writes_ = 0;

@@ -36,10 +36,20 @@ namespace {
 struct Sample {
   double strain, axial, lateral, broken;
   int phase;  // 0 loading, 1 unloading, 2 reloading
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("strain", strain), ar("axial", axial), ar("lateral", lateral), ar("broken", broken);
+    ar("phase", phase);
+  }
 };
 
 struct Cycle {
   double at_strain = 0, peak_stress = 0, peak_strain = 0, low_stress = 0, low_strain = 0;
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("at_strain", at_strain), ar("peak_stress", peak_stress), ar("peak_strain", peak_strain);
+    ar("low_stress", low_stress), ar("low_strain", low_strain);
+  }
 };
 
 // Fits over the loading points with strain in [lo, hi].
@@ -53,15 +63,24 @@ double fitWindow(const std::vector<Sample>& pts, double lo, double hi, bool stre
   return slope(x, y);
 }
 
-// What the loading loop keeps: every recorded point, the cycles, and how well the loading
-// was controlled.
+// What the loading loop keeps: every recorded point, the cycles, where it is in them, and
+// how well the loading was controlled.
 struct OedometricHistory {
   std::vector<Sample> pts;
   std::vector<Cycle> cycles;
+  std::size_t next_cycle = 0;
+  int phase = 0;
   std::uint64_t steps = 0;
   double unbalanced_sum = 0.0, inertial_max = 0.0;
   std::size_t loading_records = 0;
   double meanUnbalanced() const { return loading_records ? unbalanced_sum / loading_records : 0.0; }
+  // The loop's state in a checkpoint (rigs/common/journal.hpp).
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("pts", pts), ar("cycles", cycles), ar("next_cycle", next_cycle), ar("phase", phase);
+    ar("steps", steps), ar("unbalanced_sum", unbalanced_sum), ar("inertial_max", inertial_max);
+    ar("loading_records", loading_records);
+  }
 };
 
 // Drives the axial walls (strain rate or stress ramp; the lateral walls fixed) to the end of
@@ -83,6 +102,9 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
   const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
   const auto snapshot_every = static_cast<std::uint64_t>(sp.settings.output.snapshot_every_steps);
 
+  OedometricHistory h;
+  Journal::Unit unit = control.unit(stage);
+  if (unit.done(h, sp)) return h;
   for (int a = 0; a < D; ++a) {
     if (a != ax) frame.set(a, Axis{Mode::Fixed});
   }
@@ -94,9 +116,8 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
     frame.set(ax, Axis{Mode::Stress, 0.0, sigma0, s.axial_stress_rate});
   }
 
-  OedometricHistory h;
-  std::size_t next_cycle = 0;
-  int phase = 0;
+  std::size_t& next_cycle = h.next_cycle;
+  int& phase = h.phase;
   const std::uint64_t start = sim.steps();
   auto lateral = [&] {
     double l = 0.0;
@@ -120,7 +141,9 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
     }
   };
   record();
+  unit.resume(h, sp);
   for (;;) {
+    unit.tick(h, sp);  // before the step: the loop goes on from a checkpoint's state
     frame.step();
     const double strain = frame.strain(ax);
     const double stress = frame.stress(ax);
@@ -165,6 +188,7 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
     }
   }
   h.steps = sim.steps() - start;
+  unit.finish(h, sp);
   return h;
 }
 

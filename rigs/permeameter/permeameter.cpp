@@ -259,7 +259,8 @@ void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
   solveAndRecord();
   // Section 3.5.2: the network is solved to steady state every n particle steps, its
   // pressures applied, the permeability recorded.
-  sp.frame->couple(solveAndRecord, static_cast<std::uint64_t>(s.measurement.update_every_steps));
+  sp.frame->couple(solveAndRecord, static_cast<std::uint64_t>(s.measurement.update_every_steps),
+                   &flow);
   if (s.mode == LoadingMode::Hydrostatic) {
     servoTo(sp, s.stress_max, s.stress_max, s.stress_rate, "loading", rec, control);
     rec.result("mean_stress_peak_MPa", sp.frame->meanStress() / 1e6, "MPa");

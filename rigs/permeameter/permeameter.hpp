@@ -105,9 +105,10 @@ struct Settings {
 
 // The fluid in the run (a stage of it, not of its recording): one pore network per measured
 // direction, each solved to steady state when update() is called (every n particle steps),
-// the primary direction's pressures applied to the particles when flow.apply_forces.
+// the primary direction's pressures applied to the particles when flow.apply_forces. Its
+// state goes into the run's checkpoints with the frame it is coupled to.
 template <int D>
-class FlowStage {
+class FlowStage : public CoupledState {
  public:
   struct Direction {
     std::string name;  // "along" or "normal"
@@ -138,7 +139,21 @@ class FlowStage {
   std::uint64_t solves() const { return solves_; }
   std::uint64_t updates() const { return updates_; }
 
+  void save(ArchiveWriter& ar) override { visit(ar); }
+  void load(ArchiveReader& ar) override { visit(ar); }
+
  private:
+  template <class Archive>
+  void visit(Archive& ar) {
+    for (auto& d : dirs_) {
+      ar(d.name + ".coupling", *d.coupling), ar(d.name + ".k0", d.k0);
+      ar(d.name + ".reading", d.reading);
+    }
+    ar("triangulations", triangulations_), ar("network_seconds", network_seconds_);
+    ar("solve_seconds", solve_seconds_), ar("update_seconds", update_seconds_);
+    ar("solves", solves_), ar("updates", updates_), ar("updated", updated_);
+    ar("last_step", last_step_);
+  }
   flow::FlowReading solve(Direction& d, Simulation<D>* apply_to, const Simulation<D>& sim);
   std::vector<Direction> dirs_;
   bool apply_forces_;

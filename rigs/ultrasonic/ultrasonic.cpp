@@ -187,6 +187,13 @@ struct StageResult {
   // its background copy) and the static cycles, on copies of the sample.
   double wave_seconds = 0.0, static_seconds = 0.0;
   std::uint64_t pulses = 0, cycles = 0;
+  // A measured stage in a checkpoint (rigs/common/journal.hpp).
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("values", values), ar("min_wavelength_diameters", min_wavelength_diameters);
+    ar("max_disagreement", max_disagreement), ar("wave_seconds", wave_seconds);
+    ar("static_seconds", static_seconds), ar("pulses", pulses), ar("cycles", cycles);
+  }
 };
 
 double secondsSince(std::chrono::steady_clock::time_point t0) {
@@ -293,7 +300,8 @@ StageResult measureStage(Specimen<D>& sp, const Settings& s, const std::string& 
 }
 
 // Loads the formed specimen along the protocol's path and measures at each stage; the last
-// stage's wave fronts are kept as frames.
+// stage's wave fronts are kept as frames. Each stage's loading and its measurement are units
+// of the run's checkpoints: a measurement only reads the sample (its copies do the work).
 template <int D>
 std::vector<StageResult> loadAndMeasure(Specimen<D>& sp, const Settings& s, Recorder& rec,
                                         RunControl& control) {
@@ -305,7 +313,13 @@ std::vector<StageResult> loadAndMeasure(Specimen<D>& sp, const Settings& s, Reco
   std::vector<StageResult> stages;
   auto measure = [&](bool last) {
     const std::string stage = "stage " + std::to_string(stages.size() + 1);
-    stages.push_back(measureStage(sp, s, stage, last, rec, control));
+    Journal::Unit unit = control.unit("measure " + stage);
+    StageResult r;
+    if (!unit.done(r)) {
+      r = measureStage(sp, s, stage, last, rec, control);
+      unit.finish(r);
+    }
+    stages.push_back(std::move(r));
   };
   sp.resetBrokenCount();
   frame.resetReference();
@@ -326,18 +340,22 @@ std::vector<StageResult> loadAndMeasure(Specimen<D>& sp, const Settings& s, Reco
   const double rate = s.axial_strain_rate;
   frame.set(ax, Axis{Mode::StrainRate, rate});
   const std::vector<double>& at = s.stages_axial_strain;
-  std::size_t next = 0;
-  while (next < at.size()) {
-    frame.step();
-    if (sp.sim->steps() % record_every == 0) recordState(sp, rec, "loading.", "loading", rate);
-    if (sp.sim->steps() % 200 == 0) {
-      control.tick("loading", sp.sim->steps(), frame.strain(ax) / at.back(),
-                   "axial stress " + fmt(frame.stress(ax) / 1e6) + " MPa");
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    Journal::Unit unit = control.unit("loading to stage " + std::to_string(k + 1));
+    if (!unit.done(sp)) {
+      unit.resume(sp);
+      do {
+        unit.tick(sp);  // before the step: the loop goes on from a checkpoint's state
+        frame.step();
+        if (sp.sim->steps() % record_every == 0) recordState(sp, rec, "loading.", "loading", rate);
+        if (sp.sim->steps() % 200 == 0) {
+          control.tick("loading", sp.sim->steps(), frame.strain(ax) / at.back(),
+                       "axial stress " + fmt(frame.stress(ax) / 1e6) + " MPa");
+        }
+      } while (frame.strain(ax) < at[k]);
+      unit.finish(sp);
     }
-    if (frame.strain(ax) >= at[next]) {
-      ++next;
-      measure(next == at.size());
-    }
+    measure(k + 1 == at.size());
   }
   return stages;
 }
