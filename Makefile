@@ -4,14 +4,15 @@
 PACKAGES := build-essential cmake pkg-config git \
   libeigen3-dev libcgal-dev libvtk9-dev libosmesa6-dev libfftw3-dev \
   libsuitesparse-dev libopenblas0-serial \
-  libsqlite3-dev sqlite3 libgtest-dev libtoml11-dev libcli11-dev libbenchmark-dev xz-utils
+  libsqlite3-dev sqlite3 libgtest-dev libtoml11-dev libcli11-dev libbenchmark-dev xz-utils \
+  munge slurmctld slurmd slurm-client
 
 PRESET ?= release
 BUILD := build/$(PRESET)
 ROCKLAB := $(BUILD)/rocklab
 DEMO_DIR := build/demo
 
-.PHONY: deps build demo test test-full test-sanitize bench bench-packings catalogue references \
+.PHONY: deps build demo test test-full test-slurm test-sanitize bench bench-packings catalogue references \
   gallery format clean
 
 # Installs only the Debian packages that are missing (a no-op when all are present);
@@ -48,6 +49,10 @@ test: build
 # Every test, the full label included.
 test-full: build
 	ctest --preset full
+
+# Campaigns on a real Slurm: each test starts a one-node cluster (as root) and stops it.
+test-slurm: build
+	ctest --preset slurm
 
 # The unit tests under address and undefined-behaviour sanitizers.
 test-sanitize: deps

@@ -276,7 +276,7 @@ int runProtocol(const RunOptions& o) {
     return 2;
   }
   protocol::Settings settings = c.settings;
-  if (o.threads > 0) settings.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+  if (o.threads > 0) settings.runChoice("numerics.threads", static_cast<std::int64_t>(o.threads));
   return runSettings(*c.rig, settings, o.protocol, o.lab, o.quiet).code;
 }
 
@@ -303,7 +303,7 @@ std::optional<rigs::CheckedProtocol> recheck(std::int64_t run, const StoredRun& 
                                              int threads) {
   try {
     rigs::CheckedProtocol c = rigs::checkProtocolText(r.file, r.text, overrides);
-    if (threads > 0) c.settings.override("numerics.threads", static_cast<std::int64_t>(threads));
+    if (threads > 0) c.settings.runChoice("numerics.threads", static_cast<std::int64_t>(threads));
     return c;
   } catch (const protocol::ProtocolError& e) {
     std::cerr << "run " << run << "'s protocol (" << r.file << "):\n" << e.what() << "\n";

@@ -8,6 +8,7 @@
 
 #include "lab/cli/bench.hpp"
 #include "lab/cli/build_info.hpp"
+#include "lab/cli/campaign_commands.hpp"
 #include "lab/cli/lab_commands.hpp"
 #include "lab/cli/study_commands.hpp"
 #include "lab/core/contact_laws.hpp"
@@ -300,11 +301,24 @@ void addNotebook(CLI::App& app, Action& action) {
   del->add_option("runs", o->runs, "Run ids")->required();
   del->add_flag("--yes", o->yes, "Confirm (without it, only lists what would be removed)");
   del->callback([o] { o->what = "delete"; });
+  auto merge = std::make_shared<std::vector<std::string>>();
+  auto* mrg = nbc->add_subcommand(
+      "merge",
+      "Copy the runs of other notebooks into the lab, with their files and where they "
+      "came from (a run already there is not copied again)");
+  mrg->add_option("notebooks", *merge, "Notebooks to merge in")->required();
+  mrg->add_option("--lab", o->lab, "Lab notebook (SQLite) they go into");
   for (auto* sub : {show, ser, ev, sql, del, nbc->get_subcommand("runs")}) {
     sub->add_option("--lab", o->lab, "Lab notebook (SQLite)");
     sub->add_flag("--csv", o->csv, "Print CSV");
   }
-  nbc->callback([&action, o] { action = [o] { return rocklab::cli::notebookCommand(*o); }; });
+  nbc->callback([&action, o, mrg, merge] {
+    if (mrg->parsed()) {
+      action = [o, merge] { return rocklab::cli::notebookMerge(o->lab, *merge); };
+    } else {
+      action = [o] { return rocklab::cli::notebookCommand(*o); };
+    }
+  });
 }
 
 void addReportAndExport(CLI::App& app, Action& action) {
@@ -479,6 +493,53 @@ void addPack(CLI::App& app, Action& action) {
   });
 }
 
+void addCampaign(CLI::App& app, Action& action) {
+  auto o = std::make_shared<rocklab::cli::CampaignOptions>();
+  auto* c = app.add_subcommand(
+      "campaign",
+      "A protocol over seeds and sweeps of its keys: every point x seed a run of its own "
+      "process, on a local pool or a Slurm job array, merged into the lab with each point's "
+      "statistics");
+  c->require_subcommand(1);
+  auto file = [&](CLI::App* sub) {
+    sub->add_option("campaign", o->file, "Campaign file (TOML)")->required();
+  };
+  auto* run = c->add_subcommand("run", "Run the campaign's tasks not done yet");
+  file(run);
+  run->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+  run->add_option("--jobs", o->jobs, "Local pool: runs at once (default: cores / threads)")
+      ->check(CLI::Range(1, 4096));
+  run->add_option("--scheduler", o->scheduler, "local (a pool of processes) or slurm (sbatch)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  run->add_flag("--wait", o->wait, "slurm: wait for the job array and collect it here");
+  run->add_flag("--rerun-failed", o->rerun_failed,
+                "Run the failed and killed tasks again (from their checkpoints where kept)");
+  run->add_flag("--quiet", o->quiet, "No progress line");
+  run->callback([&action, o] { action = [o] { return rocklab::cli::campaignRun(*o); }; });
+  auto* check = c->add_subcommand("check", "Validate the campaign file and every point's protocol");
+  file(check);
+  check->callback([&action, o] { action = [o] { return rocklab::cli::campaignCheck(*o); }; });
+  auto* task = c->add_subcommand(
+      "task", "Run one task into its shard (what the pool's processes and Slurm's tasks run)");
+  file(task);
+  task->add_option("--task", o->task, "The task's index")->required();
+  task->add_option("--shard-dir", o->shard_dir, "Folder of the campaign's shards")->required();
+  task->add_option("--scratch", o->scratch, "Local storage to run in, the shard moved after");
+  task->add_flag("--quiet", o->quiet, "No progress line");
+  task->callback([&action, o] { action = [o] { return rocklab::cli::campaignTask(*o); }; });
+  auto* collect = c->add_subcommand(
+      "collect", "Merge the campaign's shards into the lab and update its statistics");
+  file(collect);
+  collect->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+  collect->add_flag("--quiet", o->quiet, "Nothing but problems");
+  collect->callback([&action, o] { action = [o] { return rocklab::cli::campaignCollect(*o); }; });
+  auto* show = c->add_subcommand(
+      "show", "Each point's key results over its seeds: n, mean, std and 95% interval");
+  file(show);
+  show->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+  show->callback([&action, o] { action = [o] { return rocklab::cli::campaignShow(*o); }; });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -498,6 +559,7 @@ int main(int argc, char** argv) {
   addStudy(app, action);
   addRegress(app, action);
   addPack(app, action);
+  addCampaign(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -162,7 +162,7 @@ int studyAccuracy(const StudyOptions& o) {
       for (const auto& [key, value] : combo) {
         s.apply({{key, value, "--vary"}});
       }
-      if (o.threads > 0) s.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+      if (o.threads > 0) s.runChoice("numerics.threads", static_cast<std::int64_t>(o.threads));
       rigs::validateProtocol(*c.rig, s);
       runs.push_back(std::move(s));
       labels.push_back(describe(combo));
@@ -251,7 +251,7 @@ std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const s
   for (int k = 0; k < o.seeds; ++k) {
     protocol::Settings s = c.settings;
     s.override("protocol.seed", seed0 + k);
-    if (o.threads > 0) s.override("numerics.threads", static_cast<std::int64_t>(o.threads));
+    if (o.threads > 0) s.runChoice("numerics.threads", static_cast<std::int64_t>(o.threads));
     const RunOutcome r = runSettings(*c.rig, s, file, o.lab, true);
     if (r.code == 130) interrupted = true;
     if (r.code != 0) {

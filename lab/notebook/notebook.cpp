@@ -219,6 +219,51 @@ CREATE TABLE inputs (
   PRIMARY KEY (run_id, key)
 );
 )sql",
+      // 6 -> 7: runs known by a uuid wherever they are merged (run_origins says from where),
+      // and campaigns: their points, the runs made for them, the ensembles' statistics.
+      R"sql(
+ALTER TABLE runs ADD COLUMN uuid TEXT;
+UPDATE runs SET uuid = lower(hex(randomblob(16)));
+CREATE UNIQUE INDEX runs_by_uuid ON runs (uuid);
+CREATE TABLE run_origins (
+  run_id INTEGER PRIMARY KEY REFERENCES runs(id) ON DELETE CASCADE,
+  notebook TEXT NOT NULL,
+  source_run INTEGER NOT NULL,
+  scheduler TEXT NOT NULL,
+  job_id TEXT,
+  task_id INTEGER
+);
+CREATE TABLE campaigns (
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL UNIQUE,
+  file TEXT NOT NULL,
+  text TEXT NOT NULL,
+  protocol TEXT NOT NULL,
+  updated TEXT NOT NULL
+);
+CREATE TABLE campaign_points (
+  campaign_id INTEGER NOT NULL REFERENCES campaigns(id) ON DELETE CASCADE,
+  point INTEGER NOT NULL,
+  seed INTEGER NOT NULL,
+  settings TEXT NOT NULL,
+  protocol_hash TEXT NOT NULL,
+  run_id INTEGER REFERENCES runs(id) ON DELETE SET NULL,
+  PRIMARY KEY (campaign_id, point, seed)
+);
+CREATE TABLE campaign_statistics (
+  campaign_id INTEGER NOT NULL REFERENCES campaigns(id) ON DELETE CASCADE,
+  point INTEGER NOT NULL,
+  settings TEXT NOT NULL,
+  name TEXT NOT NULL,
+  unit TEXT NOT NULL,
+  n INTEGER NOT NULL,
+  mean REAL,
+  std REAL,
+  ci95_low REAL,
+  ci95_high REAL,
+  PRIMARY KEY (campaign_id, point, name)
+);
+)sql",
   };
   return m;
 }
@@ -307,8 +352,8 @@ RunWriter::RunWriter(Notebook& nb, const RunInfo& info, const std::vector<ParamR
   Transaction t(db);
   auto s = db.prepare(
       "INSERT INTO runs (protocol, protocol_file, protocol_text, protocol_hash, rig, status, "
-      "started, code_version, build_type, seed, threads, host, pid) "
-      "VALUES (?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?)");
+      "started, code_version, build_type, seed, threads, host, pid, uuid) "
+      "VALUES (?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, lower(hex(randomblob(16))))");
   s.bind(1, info.protocol).bind(2, info.protocol_file).bind(3, info.protocol_text);
   s.bind(4, hashText(info.protocol_text)).bind(5, info.rig).bind(6, utcNow());
   s.bind(7, info.code_version).bind(8, info.build_type).bind(9, info.seed);

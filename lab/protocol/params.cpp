@@ -210,6 +210,11 @@ void Settings::override(const std::string& key, Value v) {
   values_[key] = std::move(v);
 }
 
+void Settings::runChoice(const std::string& key, Value v) {
+  if (!unchosen_.count(key)) unchosen_[key] = value(key);
+  override(key, std::move(v));
+}
+
 bool Settings::declared(const std::string& key) const {
   return schema_ && schema_->find(key);
 }
@@ -574,12 +579,14 @@ std::string editedText(const std::string& source,
 
 std::string Settings::effectiveText() const {
   if (overrides_.empty()) return source_;
+  std::map<std::string, Value> values = values_;  // as given: the run's choices left out
+  for (const auto& [key, v] : unchosen_) values[key] = v;
   std::string head = "# The protocol as run: " + file_ + " with ";
   std::vector<std::tuple<std::string, int, std::string>> edits;
   for (const auto& [key, o] : overrides_) {
     head += (edits.empty() ? "" : ", ") + o.label();
     const int line = given_.count(key) ? given_.at(key) : 0;
-    edits.emplace_back(key, line, tomlLiteral(values_.at(key)) + "  # " + o.label());
+    edits.emplace_back(key, line, tomlLiteral(values.at(key)) + "  # " + o.label());
   }
   head += "\n";
   // The edited file reads back to these settings, or (an override inside a multi-line value
@@ -588,7 +595,7 @@ std::string Settings::effectiveText() const {
   auto readsBack = [&](const std::string& t) {
     try {
       const Settings back = parseProtocol(file_, t, *schema_);
-      return back.values_ == values_;
+      return back.values_ == values;
     } catch (const ProtocolError&) {
       return false;
     }
@@ -601,7 +608,7 @@ std::string Settings::effectiveText() const {
     const auto [table, leaf] = splitKey(d.key);
     if (!tables.count(table)) order.push_back(table);
     const auto o = overrides_.find(d.key);
-    tables[table].push_back(leaf + " = " + tomlLiteral(values_.at(d.key)) +
+    tables[table].push_back(leaf + " = " + tomlLiteral(values.at(d.key)) +
                             (o == overrides_.end() ? "" : "  # " + o->second.label()));
   }
   text = head + "# (every key the file and the overrides give, written out)\n";

@@ -106,6 +106,9 @@ class Settings {
   // Replaces a value after parsing (the run's own choices: `--threads`, a seed of a seed
   // series), not marked in the effective text; the range is checked.
   void override(const std::string& key, Value v);
+  // The same for a choice that leaves the results as they are (`--threads`): the effective
+  // text keeps the file's value, so the protocol's hash does not depend on it.
+  void runChoice(const std::string& key, Value v);
   // Applies overrides as parseProtocol does: each validated like a key in the file, every
   // problem reported at once naming the override; marked in effectiveText().
   void apply(const std::vector<Override>& overrides);
@@ -127,6 +130,7 @@ class Settings {
   std::map<std::string, Value> values_;
   std::map<std::string, int> given_;           // key -> line (0: given by an override)
   std::map<std::string, Override> overrides_;  // key -> the override that set it last
+  std::map<std::string, Value> unchosen_;      // key -> its value before runChoice()
 };
 
 // Parses TOML text read from `file`, checks every key against the schema and returns the

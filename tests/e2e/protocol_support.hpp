@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,35 @@ inline nb::Notebook runQuick(const Lab& lab, const std::string& protocol) {
             0)
       << out;
   return nb::Notebook(lab.path);
+}
+
+// Every row of a query of the notebook at `lab`, each as one text: what two notebooks must
+// agree on.
+inline std::vector<std::string> rows(const std::string& lab, const std::string& sql) {
+  std::vector<std::string> out;
+  for (const auto& row : nb::readOnlyQuery(lab, sql).rows) {
+    std::string line;
+    for (const auto& cell : row) line += cell.str() + "|";
+    out.push_back(line);
+  }
+  return out;
+}
+
+// A campaign file beside `lab` over the quick hydrostatic protocol; `body` continues its
+// [campaign] table.
+inline std::string campaignFile(const std::string& lab, const std::string& name,
+                                const std::string& body) {
+  const std::string path = lab + "." + name + ".toml";
+  std::ofstream(path) << "[campaign]\nname = \"" << name << "\"\nprotocol = \"" << sourceDir()
+                      << "/protocols/hydrostatic-quick.toml\"\n"
+                      << body;
+  return path;
+}
+
+// Removes what a lab keeps beside its file: its runs' files and its campaigns' folders.
+inline void removeLabFiles(const Lab& lab) {
+  std::filesystem::remove_all(lab.path + ".files");
+  std::filesystem::remove_all(lab.path + ".campaigns");
 }
 
 }  // namespace rocklab::testing

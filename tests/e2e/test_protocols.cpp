@@ -419,17 +419,6 @@ TEST(Protocols, RegressCheckFailsAKeyResultMovedBeyondItsTolerance) {
 
 namespace resume {
 
-// Every row of a query, each as one text: what two notebooks must agree on.
-std::vector<std::string> rows(const std::string& lab, const std::string& sql) {
-  std::vector<std::string> out;
-  for (const auto& row : nb::readOnlyQuery(lab, sql).rows) {
-    std::string line;
-    for (const auto& cell : row) line += cell.str() + "|";
-    out.push_back(line);
-  }
-  return out;
-}
-
 // Starts `rocklab ARGS` as a child process.
 pid_t start(const std::vector<std::string>& args) {
   const pid_t pid = fork();
@@ -553,57 +542,50 @@ TEST(Protocols, SigtermLeavesAnInterruptedRunWithItsData) {
 // A run killed (SIGKILL) at a random moment of its loading and resumed ends as the run that
 // was never killed: the same final state, every record once (the delay after the loading's
 // first records is drawn anew each time; it is printed when the test fails).
-TEST(Protocols, AKilledRunResumesToTheUninterruptedRun) {
-  Lab reference("resume-reference"), killed("resume-killed");
+TEST(Protocols, AKilledRunResumesToTheUninterruptedRunOnceOrTwice) {
+  Lab reference("resume-reference"), killed("resume-killed"), twice("resume-twice");
   std::string out;
   ASSERT_EQ(resume::start(resume::quickHydrostatic(reference.path)) > 0, true);
   int status = 0;
   wait(&status);
   ASSERT_EQ(WEXITSTATUS(status), 0);
-  const double delay = resume::randomDelay(0.0, 2.0);
-  SCOPED_TRACE("killed " + std::to_string(delay) + " s into the loading");
-  ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::quickHydrostatic(killed.path)),
-                                        killed.path, delay));
-  EXPECT_EQ(resume::rows(killed.path, "SELECT status FROM runs"),
-            std::vector<std::string>{"running|"});
-  ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --threads 2 --lab " + killed.path, &out),
-            0)
-      << out;
-  EXPECT_NE(out.find("resumes from unit"), std::string::npos) << out;
-  resume::expectSameRun(reference.path, killed.path);
-  // The completed run keeps no checkpoints and cannot be resumed again.
-  EXPECT_FALSE(std::filesystem::exists(killed.path + ".files/run-1/checkpoints"));
-  EXPECT_EQ(rocklab::testing::runRocklab("resume 1 --lab " + killed.path, &out), 2);
-  EXPECT_NE(out.find("completed: nothing to resume"), std::string::npos) << out;
-  std::filesystem::remove_all(reference.path + ".files");
-  std::filesystem::remove_all(killed.path + ".files");
-}
-
-// Killed twice in one run, the second time while it was resuming.
-TEST(Protocols, ARunKilledTwiceResumesToTheUninterruptedRun) {
-  Lab reference("twice-reference"), killed("twice-killed");
-  std::string out;
-  resume::start(resume::quickHydrostatic(reference.path));
-  int status = 0;
-  wait(&status);
-  ASSERT_EQ(WEXITSTATUS(status), 0);
   std::mt19937 rng(std::random_device{}());
-  const double first = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-  const double second = std::uniform_real_distribution<double>(0.3, 1.5)(rng);
-  SCOPED_TRACE("killed " + std::to_string(first) + " s into the loading, then " +
-               std::to_string(second) + " s after resuming");
-  ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::quickHydrostatic(killed.path)),
-                                        killed.path, first));
-  const pid_t again =
-      resume::start({"resume", "1", "--quiet", "--threads", "1", "--lab", killed.path});
-  std::this_thread::sleep_for(std::chrono::duration<double>(second));
-  kill(again, SIGKILL);
-  waitpid(again, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the resumed run ended before it was killed";
-  ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --lab " + killed.path, &out), 0) << out;
-  resume::expectSameRun(reference.path, killed.path);
-  std::filesystem::remove_all(reference.path + ".files");
-  std::filesystem::remove_all(killed.path + ".files");
+  {
+    const double delay = std::uniform_real_distribution<double>(0.0, 2.0)(rng);
+    SCOPED_TRACE("killed " + std::to_string(delay) + " s into the loading");
+    ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::quickHydrostatic(killed.path)),
+                                          killed.path, delay));
+    EXPECT_EQ(rows(killed.path, "SELECT status FROM runs"), std::vector<std::string>{"running|"});
+    ASSERT_EQ(
+        rocklab::testing::runRocklab("resume 1 --quiet --threads 2 --lab " + killed.path, &out), 0)
+        << out;
+    EXPECT_NE(out.find("resumes from unit"), std::string::npos) << out;
+    resume::expectSameRun(reference.path, killed.path);
+    // The completed run keeps no checkpoints and cannot be resumed again.
+    EXPECT_FALSE(std::filesystem::exists(killed.path + ".files/run-1/checkpoints"));
+    EXPECT_EQ(rocklab::testing::runRocklab("resume 1 --lab " + killed.path, &out), 2);
+    EXPECT_NE(out.find("completed: nothing to resume"), std::string::npos) << out;
+  }
+  {
+    // Killed twice in one run, the second time while it was resuming.
+    const double first = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+    const double second = std::uniform_real_distribution<double>(0.3, 1.5)(rng);
+    SCOPED_TRACE("killed " + std::to_string(first) + " s into the loading, then " +
+                 std::to_string(second) + " s after resuming");
+    ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::quickHydrostatic(twice.path)),
+                                          twice.path, first));
+    const pid_t again =
+        resume::start({"resume", "1", "--quiet", "--threads", "1", "--lab", twice.path});
+    std::this_thread::sleep_for(std::chrono::duration<double>(second));
+    kill(again, SIGKILL);
+    waitpid(again, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the resumed run ended before it was killed";
+    ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --lab " + twice.path, &out), 0) << out;
+    resume::expectSameRun(reference.path, twice.path);
+  }
+  for (const Lab* l : {&reference, &killed, &twice}) {
+    std::filesystem::remove_all(l->path + ".files");
+  }
 }
 
 // The permeameter killed in its axial loading: the loading loop resumes from its own

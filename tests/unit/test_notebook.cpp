@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "lab/notebook/merge.hpp"
 #include "lab/notebook/queries.hpp"
 
 namespace rocklab::notebook {
@@ -311,6 +312,72 @@ TEST_F(NotebookTest, DeletingARunRemovesItsRowsAndFiles) {
   RunWriter live(nb, info(), {});
   EXPECT_THROW(nb.deleteRun(live.id()), SqlError);
   std::filesystem::remove_all(path_ + ".files");
+}
+
+// A merge copies every row of every run, and its files, under new ids (the waves' traces and
+// picks with their waves), keeps where they came from, and copies nothing the second time.
+TEST_F(NotebookTest, MergingCopiesEveryRunOnceWithItsFilesAndOrigin) {
+  namespace fs = std::filesystem;
+  const std::string shard = path_ + ".shard.sqlite";
+  {
+    Notebook s(shard);
+    recordFullRun(s, info());
+    RunWriter w(s, info(), {});
+    WaveRecord wave;
+    wave.stage = "stage 1";
+    wave.name = "pz";
+    wave.type = "P";
+    wave.source = {0.0, 1.0};
+    WaveRecord::Receiver r;
+    r.distance = 0.01;
+    r.samples = {0.5, 0.25};
+    r.xcorr_time = 1e-5;
+    r.xcorr_quality = 0.9;
+    wave.receivers.push_back(r);
+    w.wave(wave);
+    w.finish(RunStatus::Failed, "unstable");
+  }
+  Notebook nb(path_);
+  recordFullRun(nb, info());  // the lab has a run of its own: the merged ones get new ids
+  const MergeOutcome m = mergeNotebook(nb, shard, {"slurm", "812", 3});
+  ASSERT_EQ(m.runs.size(), 2u);
+  EXPECT_EQ(m.runs[0], 2);
+  EXPECT_EQ(m.source_runs[1], 2);
+  EXPECT_EQ(scalar(nb, "SELECT count(*) FROM runs"), "3");
+  for (const char* table :
+       {"params", "series", "events", "results", "stage_timings", "messages", "snapshots"}) {
+    EXPECT_EQ(scalar(nb, std::string("SELECT count(*) FROM ") + table + " WHERE run_id = 2"), "1")
+        << table;
+  }
+  EXPECT_EQ(scalar(nb, "SELECT status || ': ' || reason FROM runs WHERE id = 3"),
+            "failed: unstable");
+  EXPECT_EQ(scalar(nb,
+                   "SELECT count(*) FROM traces t JOIN waves w ON w.id = t.wave_id "
+                   "WHERE w.run_id = 3"),
+            "1");
+  EXPECT_EQ(scalar(nb,
+                   "SELECT count(*) FROM picks p JOIN waves w ON w.id = p.wave_id "
+                   "WHERE w.run_id = 3"),
+            "1");
+  // The snapshot file is the lab's now, where its row says.
+  const std::string file = scalar(nb, "SELECT path FROM snapshots WHERE run_id = 2");
+  EXPECT_NE(file.find(fs::path(path_).filename().string() + ".files/run-2/"), std::string::npos)
+      << file;
+  EXPECT_TRUE(fs::exists(nb.resolve(file))) << file;
+  EXPECT_EQ(scalar(nb,
+                   "SELECT scheduler || ' ' || job_id || ' ' || task_id || ' ' || source_run "
+                   "FROM run_origins WHERE run_id = 3"),
+            "slurm 812 3 2");
+  EXPECT_EQ(scalar(nb, "SELECT count(DISTINCT uuid) FROM runs"), "3");
+  // Twice is once.
+  const MergeOutcome again = mergeNotebook(nb, shard, {});
+  EXPECT_TRUE(again.runs.empty());
+  EXPECT_EQ(again.already, 2u);
+  EXPECT_EQ(scalar(nb, "SELECT count(*) FROM runs"), "3");
+  EXPECT_THROW(mergeNotebook(nb, path_, {}), SqlError);  // not into itself
+  for (const char* ext : {"", "-wal", "-shm"}) fs::remove(shard + ext);
+  fs::remove_all(shard + ".files");
+  fs::remove_all(path_ + ".files");
 }
 
 // FIPS 180-4's examples, the empty file, and one past a block boundary.

@@ -263,6 +263,12 @@ TEST(Protocol, EffectiveTextReadsBackToTheSettingsWithTheOverridesMarked) {
     EXPECT_EQ(it->value, row.value) << row.key;
   }
   EXPECT_EQ(back.real("numerics.local_damping"), 0.1234567890123);  // every bit
+  // A run's choice that leaves the results as they are (--threads) stays out of the text:
+  // the protocol's hash does not depend on it.
+  Settings chosen = s;
+  chosen.runChoice("numerics.local_damping", 0.5);
+  EXPECT_EQ(chosen.real("numerics.local_damping"), 0.5);
+  EXPECT_EQ(chosen.effectiveText(), effective);
   // A multi-line list cannot be replaced in place: every key is written out instead.
   const std::string multi = std::string(kGood) + "[sample]\ncount = 300\n";
   const std::string spread = std::string("[protocol]\nname = \"t\"\nrig = \"oedometer\"\n") +

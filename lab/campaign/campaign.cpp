@@ -1,0 +1,344 @@
+#include "lab/campaign/campaign.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <toml.hpp>
+
+#include "rigs/registry.hpp"
+
+namespace rocklab::campaign {
+
+namespace {
+
+using TomlValue = toml::basic_value<toml::discard_comments, std::map, std::vector>;
+
+// A TOML value written back as TOML that reads to the same value (the protocol parser
+// reads the overrides): numbers in their shortest round-trip form, texts quoted.
+std::string literal(const TomlValue& v) {
+  if (v.is_floating()) {
+    const double x = v.as_floating();
+    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+    if (std::isnan(x)) return "nan";
+    char buf[32];
+    std::string t(buf, std::to_chars(buf, buf + sizeof buf, x).ptr);
+    if (t.find_first_of(".en") == std::string::npos) t += ".0";
+    return t;
+  }
+  if (v.is_integer()) return std::to_string(v.as_integer());
+  if (v.is_boolean()) return v.as_boolean() ? "true" : "false";
+  if (v.is_string()) {
+    std::string q = "\"";
+    for (char c : v.as_string().str) {
+      if (c == '"' || c == '\\') q += '\\';
+      q += c;
+    }
+    return q + "\"";
+  }
+  if (v.is_array()) {
+    std::string t = "[";
+    for (std::size_t k = 0; k < v.as_array().size(); ++k) {
+      t += (k ? ", " : "") + literal(v.as_array()[k]);
+    }
+    return t + "]";
+  }
+  return "";  // tables and dates: refused by the caller
+}
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  std::string at(const TomlValue& v) const {
+    return file_ + ":" + std::to_string(v.location().line());
+  }
+  void problem(const TomlValue& v, const std::string& what) {
+    problems_.push_back(at(v) + ": " + what);
+  }
+  void problem(const std::string& what) { problems_.push_back(file_ + ": " + what); }
+  void throwIfAny() const {
+    if (!problems_.empty()) throw protocol::ProtocolError(problems_);
+  }
+  // The keys of a table and its nested tables, dotted ("loading.rate" from [set.loading]).
+  static void flatten(const TomlValue& table, const std::string& prefix,
+                      std::vector<std::pair<std::string, const TomlValue*>>& out) {
+    for (const auto& [k, v] : table.as_table()) {
+      const std::string key = prefix.empty() ? k : prefix + "." + k;
+      if (v.is_table()) {
+        flatten(v, key, out);
+      } else {
+        out.emplace_back(key, &v);
+      }
+    }
+  }
+
+ private:
+  std::string file_;
+  std::vector<std::string> problems_;
+};
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw protocol::ProtocolError({path + ": cannot read the campaign file"});
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The [campaign] table.
+void readHead(const TomlValue& t, Campaign& c, Reader& r, const TomlValue*& seeds) {
+  for (const auto& [k, v] : t.as_table()) {
+    if (k == "name") {
+      if (!v.is_string() || v.as_string().str.empty() ||
+          v.as_string().str.find_first_of("/\\ \t") != std::string::npos) {
+        r.problem(v,
+                  "campaign.name: a text without spaces or slashes (it names the "
+                  "campaign's folder and its rows in the notebook)");
+      } else {
+        c.name = v.as_string().str;
+      }
+    } else if (k == "protocol") {
+      if (!v.is_string()) {
+        r.problem(v, "campaign.protocol: the protocol file (text), relative to this file");
+      } else {
+        c.protocol = v.as_string().str;
+      }
+    } else if (k == "seeds") {
+      seeds = &v;
+    } else if (k == "combine") {
+      if (v.is_string() && v.as_string().str == "product") {
+        continue;
+      } else if (!(v.is_string() && v.as_string().str == "zip")) {
+        r.problem(v, "campaign.combine: one of product, zip");
+      }
+    } else if (k == "threads") {
+      if (!v.is_integer() || v.as_integer() < 1 || v.as_integer() > 1024) {
+        r.problem(v, "campaign.threads: each run's threads, an integer in [1, 1024]");
+      } else {
+        c.threads = static_cast<int>(v.as_integer());
+      }
+    } else {
+      r.problem(
+          v, "campaign." + k + ": unknown key (campaign.name, protocol, seeds, combine, threads)");
+    }
+  }
+  if (c.name.empty() && t.as_table().count("name") == 0) r.problem("missing campaign.name");
+  if (c.protocol.empty() && t.as_table().count("protocol") == 0) {
+    r.problem("missing campaign.protocol: the protocol file the campaign runs");
+  }
+}
+
+void readSlurm(const TomlValue& t, SlurmOptions& s, Reader& r) {
+  for (const auto& [k, v] : t.as_table()) {
+    auto text = [&](std::string& out) {
+      if (v.is_string()) {
+        out = v.as_string().str;
+      } else {
+        r.problem(v, "slurm." + k + ": a text");
+      }
+    };
+    if (k == "partition") {
+      text(s.partition);
+    } else if (k == "time") {
+      text(s.time);
+    } else if (k == "account") {
+      text(s.account);
+    } else if (k == "cpus_per_task") {
+      if (!v.is_integer() || v.as_integer() < 1 || v.as_integer() > 1024) {
+        r.problem(v, "slurm.cpus_per_task: an integer in [1, 1024]");
+      } else {
+        s.cpus_per_task = static_cast<int>(v.as_integer());
+      }
+    } else if (k == "options") {
+      bool texts = v.is_array();
+      if (texts) {
+        for (const auto& o : v.as_array()) texts = texts && o.is_string();
+      }
+      if (!texts) {
+        r.problem(v, "slurm.options: a list of sbatch options, e.g. [\"--mem=2G\"]");
+      } else {
+        for (const auto& o : v.as_array()) s.options.push_back(o.as_string().str);
+      }
+    } else {
+      r.problem(v, "slurm." + k +
+                       ": unknown key (slurm.partition, time, account, cpus_per_task, options)");
+    }
+  }
+}
+
+}  // namespace
+
+std::string Point::label() const {
+  if (settings.empty()) return "base";
+  std::string s;
+  for (const auto& o : settings) s += (s.empty() ? "" : ", ") + o.key + "=" + o.value;
+  return s;
+}
+
+std::vector<Task> Campaign::tasks() const {
+  std::vector<Task> out;
+  for (const Point& p : points) {
+    for (std::int64_t seed : seeds) {
+      out.push_back({static_cast<int>(out.size()), p.index, seed});
+    }
+  }
+  return out;
+}
+
+std::vector<protocol::Override> Campaign::overrides(const Task& t, bool with_lines) const {
+  std::vector<protocol::Override> o = fixed;
+  const Point& p = points.at(static_cast<std::size_t>(t.point));
+  o.insert(o.end(), p.settings.begin(), p.settings.end());
+  o.push_back({"protocol.seed", std::to_string(t.seed), file + ": campaign.seeds"});
+  if (!with_lines) {
+    for (auto& x : o) x.origin = "campaign " + name;
+  }
+  return o;
+}
+
+Campaign readCampaign(const std::string& path) {
+  Campaign c;
+  c.file = path;
+  c.text = readText(path);
+  TomlValue root;
+  try {
+    std::istringstream in(c.text);
+    root = toml::parse<toml::discard_comments, std::map, std::vector>(in, path);
+  } catch (const std::exception& e) {
+    throw protocol::ProtocolError({path + ": not valid TOML:\n" + e.what()});
+  }
+  Reader r(path);
+  const TomlValue* seeds = nullptr;
+  std::vector<std::pair<std::string, const TomlValue*>> fixed, sweeps;
+  bool zip = false;
+  for (const auto& [k, v] : root.as_table()) {
+    if (!v.is_table()) {
+      r.problem(v, k + ": a key outside a table ([campaign], [set], [sweep], [slurm])");
+    } else if (k == "campaign") {
+      readHead(v, c, r, seeds);
+      zip = v.as_table().count("combine") && v.at("combine").is_string() &&
+            v.at("combine").as_string().str == "zip";
+    } else if (k == "set") {
+      Reader::flatten(v, "", fixed);
+    } else if (k == "sweep") {
+      Reader::flatten(v, "", sweeps);
+    } else if (k == "slurm") {
+      readSlurm(v, c.slurm, r);
+    } else {
+      r.problem(v, "[" + k + "]: unknown table ([campaign], [set], [sweep], [slurm])");
+    }
+  }
+  if (!root.as_table().count("campaign")) r.problem("missing the [campaign] table");
+  // In the file's order (the tables are read sorted by name): the first sweep varies slowest.
+  for (auto* keys : {&fixed, &sweeps}) {
+    std::stable_sort(keys->begin(), keys->end(), [](const auto& a, const auto& b) {
+      return a.second->location().line() < b.second->location().line();
+    });
+  }
+  r.throwIfAny();
+
+  namespace fs = std::filesystem;
+  if (fs::path(c.protocol).is_relative()) {
+    c.protocol = (fs::path(path).parent_path() / c.protocol).lexically_normal().string();
+  }
+  for (const auto& [key, v] : fixed) {
+    const std::string text = literal(*v);
+    if (text.empty()) {
+      r.problem(*v, "set." + key + ": a number, text, boolean or list");
+    } else {
+      c.fixed.push_back({key, text, r.at(*v)});
+    }
+  }
+  // Each sweep's values, then the points they make.
+  std::vector<std::vector<protocol::Override>> values;
+  for (const auto& [key, v] : sweeps) {
+    if (!v->is_array() || v->as_array().empty()) {
+      r.problem(*v, "sweep." + key + ": a non-empty list of the values the key takes");
+      continue;
+    }
+    std::vector<protocol::Override> list;
+    for (const auto& e : v->as_array()) {
+      const std::string text = literal(e);
+      if (text.empty()) {
+        r.problem(e, "sweep." + key + ": a value is a table or date, not a protocol value");
+      } else {
+        list.push_back({key, text, r.at(e)});
+      }
+    }
+    values.push_back(std::move(list));
+  }
+  if (zip) {
+    for (std::size_t k = 1; k < values.size(); ++k) {
+      if (values[k].size() != values[0].size()) {
+        r.problem(*sweeps[k].second,
+                  "sweep." + sweeps[k].first + ": " + std::to_string(values[k].size()) +
+                      " values, but combine = \"zip\" needs as many as sweep." + sweeps[0].first +
+                      " has (" + std::to_string(values[0].size()) + ")");
+      }
+    }
+  }
+  // The seeds: a list, or a count from the protocol's own seed on.
+  if (!seeds) {
+    r.problem(
+        "missing campaign.seeds: a count (the protocol's seed and the ones after it) or "
+        "a list of seeds");
+  } else if (seeds->is_integer()) {
+    const auto n = seeds->as_integer();
+    if (n < 1 || n > 100000) {
+      r.problem(*seeds, "campaign.seeds: a count in [1, 100000], or a list of seeds");
+    } else {
+      std::int64_t first = 1;
+      try {
+        first = rigs::checkProtocol(c.protocol, c.fixed).settings.integer("protocol.seed");
+      } catch (const protocol::ProtocolError& e) {
+        for (const auto& p : e.problems()) r.problem(p);
+      }
+      for (std::int64_t k = 0; k < n; ++k) c.seeds.push_back(first + k);
+    }
+  } else if (seeds->is_array() && !seeds->as_array().empty()) {
+    for (const auto& s : seeds->as_array()) {
+      if (!s.is_integer() || s.as_integer() < 0) {
+        r.problem(s, "campaign.seeds: every seed an integer >= 0");
+      } else {
+        for (std::int64_t known : c.seeds) {
+          if (known == s.as_integer())
+            r.problem(s, "campaign.seeds: seed " + std::to_string(known) + " twice");
+        }
+        c.seeds.push_back(s.as_integer());
+      }
+    }
+  } else {
+    r.problem(*seeds, "campaign.seeds: a count, or a non-empty list of seeds");
+  }
+  r.throwIfAny();
+  std::vector<std::vector<protocol::Override>> points = {{}};
+  if (zip && !values.empty()) {
+    points.assign(values[0].size(), {});
+    for (const auto& list : values) {
+      for (std::size_t k = 0; k < list.size(); ++k) points[k].push_back(list[k]);
+    }
+  } else {
+    for (const auto& list : values) {
+      std::vector<std::vector<protocol::Override>> next;
+      for (const auto& p : points) {
+        for (const auto& o : list) {
+          next.push_back(p);
+          next.back().push_back(o);
+        }
+      }
+      points = std::move(next);
+    }
+  }
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    c.points.push_back({static_cast<int>(k), points[k]});
+  }
+
+  r.throwIfAny();
+  return c;
+}
+
+}  // namespace rocklab::campaign

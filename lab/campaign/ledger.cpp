@@ -1,0 +1,108 @@
+#include "lab/campaign/ledger.hpp"
+
+#include <filesystem>
+#include <map>
+
+#include "lab/campaign/statistics.hpp"
+#include "rigs/registry.hpp"
+
+namespace rocklab::campaign {
+
+std::string taskProtocolHash(const Campaign& c, const Task& t) {
+  return notebook::hashText(
+      rigs::checkProtocol(c.protocol, c.overrides(t)).settings.effectiveText());
+}
+
+std::int64_t registerCampaign(notebook::Notebook& lab, const Campaign& c) {
+  auto& db = lab.db();
+  db.prepare(
+        "INSERT INTO campaigns (name, file, text, protocol, updated) VALUES (?, ?, ?, ?, ?) "
+        "ON CONFLICT (name) DO UPDATE SET file = excluded.file, text = excluded.text, "
+        "protocol = excluded.protocol, updated = excluded.updated")
+      .bind(1, c.name)
+      .bind(2, std::filesystem::absolute(c.file).string())
+      .bind(3, c.text)
+      .bind(4, std::filesystem::absolute(c.protocol).string())
+      .bind(5, notebook::utcNow())
+      .run();
+  auto s = db.prepare("SELECT id FROM campaigns WHERE name = ?");
+  s.bind(1, c.name);
+  s.step();
+  return s.integer(0);
+}
+
+std::vector<TaskState> survey(notebook::Notebook& lab, const Campaign& c,
+                              const std::vector<std::string>& hashes) {
+  std::vector<TaskState> out;
+  // The completed run first, else the latest.
+  auto s = lab.db().prepare(
+      "SELECT id, status, coalesce(reason, '') FROM runs WHERE protocol_hash = ? AND seed = ? "
+      "ORDER BY status = 'completed' DESC, id DESC LIMIT 1");
+  const std::vector<Task> tasks = c.tasks();
+  for (std::size_t k = 0; k < tasks.size(); ++k) {
+    TaskState t{tasks[k], hashes.at(k), 0, "", ""};
+    s.bind(1, t.hash).bind(2, t.task.seed);
+    if (s.step()) {
+      t.run = s.integer(0);
+      t.status = s.text(1);
+      t.reason = s.text(2);
+    }
+    s.reset();
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+void recordTask(notebook::Notebook& lab, std::int64_t campaign, const Campaign& c,
+                const TaskState& t) {
+  auto s = lab.db().prepare(
+      "INSERT INTO campaign_points (campaign_id, point, seed, settings, protocol_hash, run_id) "
+      "VALUES (?, ?, ?, ?, ?, ?) ON CONFLICT (campaign_id, point, seed) DO UPDATE SET "
+      "settings = excluded.settings, protocol_hash = excluded.protocol_hash, "
+      "run_id = excluded.run_id");
+  s.bind(1, campaign).bind(2, t.task.point).bind(3, t.task.seed);
+  s.bind(4, c.points.at(static_cast<std::size_t>(t.task.point)).label()).bind(5, t.hash);
+  if (t.run > 0) {
+    s.bind(6, t.run);
+  } else {
+    s.bindNull(6);
+  }
+  s.run();
+}
+
+void updateStatistics(notebook::Notebook& lab, std::int64_t campaign, const Campaign& c) {
+  auto& db = lab.db();
+  notebook::Transaction tx(db);
+  db.prepare("DELETE FROM campaign_statistics WHERE campaign_id = ?").bind(1, campaign).run();
+  auto results = db.prepare(
+      "SELECT r.name, r.unit, r.value FROM campaign_points p JOIN runs u ON u.id = p.run_id "
+      "JOIN results r ON r.run_id = p.run_id WHERE p.campaign_id = ? AND p.point = ? AND "
+      "u.status = 'completed' AND r.value IS NOT NULL ORDER BY r.name, p.seed");
+  auto insert = db.prepare(
+      "INSERT INTO campaign_statistics (campaign_id, point, settings, name, unit, n, mean, std, "
+      "ci95_low, ci95_high) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  for (const Point& p : c.points) {
+    std::map<std::string, std::pair<std::string, std::vector<double>>> by_name;
+    results.bind(1, campaign).bind(2, p.index);
+    while (results.step()) {
+      auto& [unit, values] = by_name[results.text(0)];
+      unit = results.text(1);
+      values.push_back(results.real(2));
+    }
+    results.reset();
+    for (const auto& [name, entry] : by_name) {
+      const Summary m = summarize(entry.second);
+      insert.bind(1, campaign).bind(2, p.index).bind(3, p.label()).bind(4, name);
+      insert.bind(5, entry.first).bind(6, static_cast<std::int64_t>(m.n)).bind(7, m.mean);
+      if (m.n < 2) {
+        insert.bind(8, m.std).bindNull(9).bindNull(10);
+      } else {
+        insert.bind(8, m.std).bind(9, m.low).bind(10, m.high);
+      }
+      insert.run();
+    }
+  }
+  tx.commit();
+}
+
+}  // namespace rocklab::campaign

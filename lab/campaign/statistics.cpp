@@ -1,0 +1,88 @@
+#include "lab/campaign/statistics.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace rocklab::campaign {
+
+namespace {
+
+// The continued fraction of the regularized incomplete beta function I_x(a, b), evaluated
+// by the modified Lentz method (DLMF 8.17.22; Press et al., Numerical Recipes, 6.4).
+double betaFraction(double a, double b, double x) {
+  constexpr double tiny = 1e-300;
+  double c = 1.0, d = 1.0 - (a + b) * x / (a + 1.0);
+  if (std::abs(d) < tiny) d = tiny;
+  d = 1.0 / d;
+  double f = d;
+  for (int m = 1; m <= 10000; ++m) {
+    // The even and the odd term of the fraction for this m.
+    const double even = m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m));
+    const double odd = -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0));
+    for (double term : {even, odd}) {
+      d = 1.0 + term * d;
+      if (std::abs(d) < tiny) d = tiny;
+      c = 1.0 + term / c;
+      if (std::abs(c) < tiny) c = tiny;
+      d = 1.0 / d;
+      f *= c * d;
+    }
+    if (std::abs(c * d - 1.0) < 1e-15) return f;
+  }
+  return f;
+}
+
+double regularizedBeta(double a, double b, double x) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
+                                a * std::log(x) + b * std::log1p(-x));
+  // The fraction converges fast on the side of the mean; the symmetry I_x(a,b) = 1 -
+  // I_{1-x}(b,a) gives the other.
+  if (x < (a + 1.0) / (a + b + 2.0)) return front * betaFraction(a, b, x) / a;
+  return 1.0 - front * betaFraction(b, a, 1.0 - x) / b;
+}
+
+// P(T <= t) for t >= 0 with df degrees of freedom: 1 - I_{df/(df+t^2)}(df/2, 1/2) / 2.
+double studentCdf(double t, double df) {
+  return 1.0 - 0.5 * regularizedBeta(df / 2.0, 0.5, df / (df + t * t));
+}
+
+}  // namespace
+
+double studentT975(std::size_t df) {
+  if (df == 0) throw std::invalid_argument("Student's t needs at least one degree of freedom");
+  const double nu = static_cast<double>(df);
+  // Bisection on the CDF: it rises monotonically; t(0.975) lies in [1.9, 12.8] for df >= 1.
+  double lo = 1.9, hi = 12.8;
+  for (int k = 0; k < 200 && hi - lo > 1e-13; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (studentCdf(mid, nu) < 0.975 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+Summary summarize(const std::vector<double>& values) {
+  Summary s;
+  s.n = values.size();
+  if (s.n == 0) {
+    s.mean = s.std = s.low = s.high = std::numeric_limits<double>::quiet_NaN();
+    return s;
+  }
+  for (double v : values) s.mean += v;
+  s.mean /= static_cast<double>(s.n);
+  if (s.n < 2) {
+    s.low = s.high = std::numeric_limits<double>::quiet_NaN();
+    return s;
+  }
+  double ss = 0.0;
+  for (double v : values) ss += (v - s.mean) * (v - s.mean);
+  s.std = std::sqrt(ss / static_cast<double>(s.n - 1));
+  const double half = studentT975(s.n - 1) * s.std / std::sqrt(static_cast<double>(s.n));
+  s.low = s.mean - half;
+  s.high = s.mean + half;
+  return s;
+}
+
+}  // namespace rocklab::campaign

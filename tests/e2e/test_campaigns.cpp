@@ -1,0 +1,188 @@
+// Campaigns end to end: every point x seed run once as its own process and merged into the
+// lab with each point's statistics; a campaign run again does nothing; a task killed is
+// listed and, on request, resumed from its checkpoint; a run of a campaign is the run the
+// same settings make by hand, bit for bit.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <fstream>
+#include <regex>
+#include <thread>
+
+#include "tests/e2e/protocol_support.hpp"
+
+namespace rocklab::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A run's results, but for the wall times.
+std::vector<std::string> resultsOf(const std::string& lab, std::int64_t run) {
+  return rows(lab, "SELECT name, value FROM results WHERE name NOT LIKE '%seconds' AND run_id = " +
+                       std::to_string(run) + " ORDER BY name");
+}
+
+TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
+  Lab lab("campaign"), by_hand("campaign-by-hand");
+  const std::string file = campaignFile(lab.path, "friction", R"(seeds = 2
+[set]
+"sample.count" = 200
+[sweep]
+"material.friction" = [0.3, 0.5]
+)");
+  std::string out;
+  ASSERT_EQ(runRocklab("campaign check " + file, &out), 0) << out;
+  EXPECT_NE(out.find("2 points x 2 seeds = 4 runs"), std::string::npos) << out;
+  ASSERT_EQ(runRocklab("campaign run " + file + " --jobs 2 --quiet --lab " + lab.path, &out), 0)
+      << out;
+  EXPECT_EQ(rows(lab.path, "SELECT count(*) FROM runs WHERE status = 'completed'"),
+            std::vector<std::string>{"4|"});
+  // Each task's run noted once, from its own process and shard.
+  EXPECT_EQ(rows(lab.path, "SELECT count(DISTINCT run_id) FROM campaign_points"),
+            std::vector<std::string>{"4|"});
+  EXPECT_EQ(rows(lab.path,
+                 "SELECT group_concat(task_id) FROM (SELECT task_id FROM run_origins "
+                 "WHERE scheduler = 'local' ORDER BY task_id)"),
+            std::vector<std::string>{"0,1,2,3|"});
+  EXPECT_TRUE(rows(lab.path,
+                   "SELECT 1 FROM runs r JOIN run_origins o ON o.run_id = r.id "
+                   "GROUP BY r.pid HAVING count(*) > 1")
+                  .empty())
+      << "two tasks ran in one process";
+  // The statistics of each point are those of its runs' results.
+  EXPECT_EQ(rows(lab.path,
+                 "SELECT count(*) FROM campaign_statistics s WHERE s.n = 2 AND abs(s.mean - "
+                 "(SELECT avg(r.value) FROM results r JOIN campaign_points p ON p.run_id = "
+                 "r.run_id WHERE p.point = s.point AND r.name = s.name)) > 1e-12 * abs(s.mean)"),
+            std::vector<std::string>{"0|"});
+  EXPECT_EQ(rows(lab.path,
+                 "SELECT count(*) > 10 FROM campaign_statistics WHERE n = 2 AND "
+                 "ci95_low < mean AND mean < ci95_high OR std = 0"),
+            std::vector<std::string>{"1|"});
+  ASSERT_EQ(runRocklab("campaign show " + file + " --lab " + lab.path, &out), 0) << out;
+  EXPECT_NE(out.find("point 1 (material.friction=0.5): 2/2 runs completed"), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("mean_stress_peak_MPa"), std::string::npos) << out;
+  // The shards are merged and gone.
+  EXPECT_FALSE(fs::exists(lab.path + ".campaigns/friction/task-0.sqlite"));
+  // Run again: nothing to do.
+  ASSERT_EQ(runRocklab("campaign run " + file + " --quiet --lab " + lab.path, &out), 0) << out;
+  EXPECT_NE(out.find("0 of 4 runs to do"), std::string::npos) << out;
+  EXPECT_EQ(rows(lab.path, "SELECT count(*) FROM runs"), std::vector<std::string>{"4|"});
+  // A task's run is the run of the same settings by hand.
+  const std::string seed =
+      rows(lab.path, "SELECT seed FROM campaign_points WHERE point = 1 ORDER BY seed DESC")[0];
+  ASSERT_EQ(runRocklab("run " + sourceDir() +
+                           "/protocols/hydrostatic-quick.toml --quiet --set sample.count=200 "
+                           "--set material.friction=0.5 --set protocol.seed=" +
+                           seed.substr(0, seed.size() - 1) + " --lab " + by_hand.path,
+                       &out),
+            0)
+      << out;
+  const std::string task_run =
+      rows(lab.path, "SELECT run_id FROM campaign_points WHERE point = 1 ORDER BY seed DESC")[0];
+  EXPECT_EQ(resultsOf(lab.path, std::stoll(task_run)), resultsOf(by_hand.path, 1));
+  // The lab merged into another, twice: the runs once.
+  Lab other("campaign-merged");
+  ASSERT_EQ(runRocklab("notebook merge " + lab.path + " --lab " + other.path, &out), 0) << out;
+  ASSERT_EQ(runRocklab("notebook merge " + lab.path + " --lab " + other.path, &out), 0) << out;
+  EXPECT_NE(out.find("0 runs merged into " + other.path + ", 4 there already"), std::string::npos)
+      << out;
+  EXPECT_EQ(rows(other.path, "SELECT count(*) FROM runs"), std::vector<std::string>{"4|"});
+  fs::remove(file);
+  removeLabFiles(lab);
+  removeLabFiles(by_hand);
+  removeLabFiles(other);
+}
+
+// A task killed (SIGKILL, as a lost node would) is listed with its reason; the campaign run
+// again with --rerun-failed resumes it from its checkpoint, to the run an uninterrupted
+// campaign makes.
+TEST(Campaigns, AKilledTaskIsListedAndResumedFromItsCheckpointOnRequest) {
+  Lab lab("campaign-killed"), reference("campaign-reference");
+  const std::string body = R"(seeds = [3, 4]
+[set]
+"sample.count" = 400
+"output.checkpoint_every_s" = 0.2
+)";
+  const std::string file = campaignFile(lab.path, "killed", body);
+  const std::string shard = lab.path + ".campaigns/killed/task-0.sqlite";
+  const pid_t campaign = fork();
+  if (campaign == 0) {
+    std::freopen("/dev/null", "w", stderr);
+    execl(ROCKLAB_BINARY, ROCKLAB_BINARY, "campaign", "run", file.c_str(), "--jobs", "1", "--quiet",
+          "--lab", lab.path.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // The first task's process, once its loading reaches its shard.
+  pid_t task = 0;
+  for (int k = 0; k < 1200 && task == 0; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    try {
+      if (rows(shard, "SELECT 1 FROM series WHERE name LIKE 'loading.%' LIMIT 1").size() == 1) {
+        task = static_cast<pid_t>(std::stol(rows(shard, "SELECT pid FROM runs")[0]));
+      }
+    } catch (const std::exception&) {  // not there yet
+    }
+  }
+  ASSERT_GT(task, 0) << "the first task never reached its loading";
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  kill(task, SIGKILL);
+  int status = 0;
+  waitpid(campaign, &status, 0);
+  EXPECT_EQ(WEXITSTATUS(status), 1) << "a campaign with a failed task ends with 1";
+  std::string out;
+  ASSERT_EQ(runRocklab("campaign show " + file + " --lab " + lab.path, &out), 0) << out;
+  EXPECT_NE(out.find("task 0 (base, seed 3): run 1 failed: the process ended"), std::string::npos)
+      << out;
+  EXPECT_TRUE(fs::exists(shard)) << "the failed task's shard is kept for its resumption";
+  const auto killed_uuid = rows(lab.path, "SELECT uuid FROM runs WHERE status = 'failed'");
+  ASSERT_EQ(killed_uuid.size(), 1u);
+  ASSERT_EQ(runRocklab("campaign run " + file + " --rerun-failed --quiet --lab " + lab.path, &out),
+            0)
+      << out;
+  EXPECT_EQ(rows(lab.path, "SELECT count(*) FROM runs WHERE status = 'completed'"),
+            std::vector<std::string>{"2|"});
+  EXPECT_EQ(rows(lab.path, "SELECT count(*) FROM runs"), std::vector<std::string>{"2|"});
+  // Resumed, not run anew: the completed run is the killed one (its uuid), continued.
+  EXPECT_EQ(rows(lab.path,
+                 "SELECT r.uuid FROM runs r JOIN campaign_points p ON p.run_id = r.id "
+                 "WHERE p.seed = 3 AND r.status = 'completed'"),
+            killed_uuid);
+  // The killed task against the same task never killed.
+  const std::string reference_file =
+      campaignFile(reference.path, "killed", std::regex_replace(body, std::regex("3, 4"), "3"));
+  ASSERT_EQ(runRocklab("campaign run " + reference_file + " --quiet --lab " + reference.path, &out),
+            0)
+      << out;
+  for (const char* sql :
+       {"SELECT r.name, r.value FROM results r JOIN campaign_points p ON p.run_id = r.run_id "
+        "WHERE p.seed = 3 AND r.name NOT LIKE '%seconds' ORDER BY r.name",
+        "SELECT m.text FROM messages m JOIN campaign_points p ON p.run_id = m.run_id WHERE "
+        "p.seed = 3 AND m.text LIKE 'final state hash%'"}) {
+    const auto resumed = rows(lab.path, sql);
+    EXPECT_FALSE(resumed.empty()) << sql;
+    EXPECT_EQ(resumed, rows(reference.path, sql)) << sql;
+  }
+  fs::remove(file);
+  fs::remove(reference_file);
+  removeLabFiles(lab);
+  removeLabFiles(reference);
+}
+
+// The campaigns that ship with the protocols are valid, every point of them.
+TEST(Campaigns, ShippedCampaignsCheck) {
+  int checked = 0;
+  for (const auto& f : fs::directory_iterator(sourceDir() + "/protocols/campaigns")) {
+    if (f.path().extension() != ".toml") continue;
+    std::string out;
+    EXPECT_EQ(runRocklab("campaign check " + f.path().string(), &out), 0) << out;
+    EXPECT_NE(out.find("5 seeds"), std::string::npos) << out;
+    ++checked;
+  }
+  EXPECT_GE(checked, 5);
+}
+
+}  // namespace
+}  // namespace rocklab::testing

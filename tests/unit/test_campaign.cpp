@@ -1,0 +1,165 @@
+// Campaign files read like protocols (every problem with its line), the points their sweeps
+// make, and the statistics of an ensemble (Student's t against tabulated quantiles).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "lab/campaign/campaign.hpp"
+#include "lab/campaign/statistics.hpp"
+
+namespace fs = std::filesystem;
+using namespace rocklab::campaign;
+
+namespace {
+
+class CampaignFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("rocklab-campaign-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    fs::copy_file(fs::path(ROCKLAB_SOURCE_DIR) / "protocols/biaxial-ucs-quick.toml",
+                  dir_ / "ucs.toml");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string write(const std::string& text) {
+    const std::string path = (dir_ / "c.toml").string();
+    std::ofstream(path) << text;
+    return path;
+  }
+  // The problems a file gets, joined.
+  std::string problems(const std::string& text) {
+    try {
+      readCampaign(write(text));
+    } catch (const rocklab::protocol::ProtocolError& e) {
+      std::string all;
+      for (const auto& p : e.problems()) all += p + "\n";
+      return all;
+    }
+    return "";
+  }
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(CampaignFile, SweepsMakeProductOrZippedPointsTimesSeeds) {
+  Campaign c = readCampaign(write(R"(
+[campaign]
+name = "ucs-sweep"
+protocol = "ucs.toml"
+seeds = 3
+[set]
+"sample.count" = 300
+[sweep]
+"bonds.tensile_strength_mean_MPa" = [4.0, 8.0]
+"loading.confining_stress_MPa" = [0, 1, 2]
+)"));
+  EXPECT_EQ(c.name, "ucs-sweep");
+  EXPECT_EQ(c.protocol, (dir_ / "ucs.toml").string());
+  ASSERT_EQ(c.points.size(), 6u);  // 2 x 3, the first key varying slowest
+  EXPECT_EQ(c.points[1].label(),
+            "bonds.tensile_strength_mean_MPa=4.0, loading.confining_stress_MPa=1");
+  EXPECT_EQ(c.points[3].label(),
+            "bonds.tensile_strength_mean_MPa=8.0, loading.confining_stress_MPa=0");
+  // A count of seeds: the protocol's own seed and the ones after it.
+  ASSERT_EQ(c.seeds.size(), 3u);
+  EXPECT_EQ(c.seeds[1], c.seeds[0] + 1);
+  const auto tasks = c.tasks();
+  ASSERT_EQ(tasks.size(), 18u);
+  EXPECT_EQ(tasks[4].point, 1);
+  EXPECT_EQ(tasks[4].seed, c.seeds[1]);
+  // A task's overrides: the fixed keys, the point's, the seed; named by the campaign.
+  const auto o = c.overrides(tasks[4]);
+  ASSERT_EQ(o.size(), 4u);
+  EXPECT_EQ(o[0].key, "sample.count");
+  EXPECT_EQ(o[3].key, "protocol.seed");
+  EXPECT_EQ(o[3].value, std::to_string(c.seeds[1]));
+  EXPECT_EQ(o[1].origin, "campaign ucs-sweep");
+  EXPECT_NE(c.overrides(tasks[4], true)[1].origin.find("c.toml:"), std::string::npos);
+
+  c = readCampaign(write(R"(
+[campaign]
+name = "zipped"
+protocol = "ucs.toml"
+seeds = [5, 9]
+combine = "zip"
+[sweep.loading]
+confining_stress_MPa = [0, 1, 2]
+axial_strain_rate_per_s = [0.1, 0.2, 0.4]
+)"));
+  ASSERT_EQ(c.points.size(), 3u);
+  EXPECT_EQ(c.points[2].label(),  // the keys in the file's order
+            "loading.confining_stress_MPa=2, loading.axial_strain_rate_per_s=0.4");
+  EXPECT_EQ(c.seeds, (std::vector<std::int64_t>{5, 9}));
+}
+
+TEST_F(CampaignFile, EveryProblemIsNamedWithItsLine) {
+  const std::string p = problems(R"(
+[campaign]
+name = "has space"
+protocol = "ucs.toml"
+seeds = 0
+combine = "cartesian"
+colour = "red"
+[sweep]
+"loading.confining_stress_MPa" = 3
+[slurm]
+cpus_per_task = 0
+queue = "x"
+[extras]
+a = 1
+)");
+  EXPECT_NE(p.find("c.toml:3: campaign.name: a text without spaces"), std::string::npos) << p;
+  EXPECT_NE(p.find("c.toml:6: campaign.combine: one of product, zip"), std::string::npos) << p;
+  EXPECT_NE(p.find("c.toml:7: campaign.colour: unknown key"), std::string::npos) << p;
+  EXPECT_NE(p.find("c.toml:11: slurm.cpus_per_task: an integer in [1, 1024]"), std::string::npos)
+      << p;
+  EXPECT_NE(p.find("c.toml:12: slurm.queue: unknown key"), std::string::npos) << p;
+  EXPECT_NE(p.find("[extras]: unknown table"), std::string::npos) << p;
+  const std::string q = problems(R"(
+[campaign]
+name = "n"
+protocol = "ucs.toml"
+seeds = [1, 1]
+combine = "zip"
+[sweep]
+"loading.confining_stress_MPa" = [0, 1]
+"loading.axial_strain_rate_per_s" = [0.1]
+)");
+  EXPECT_NE(q.find("c.toml:5: campaign.seeds: seed 1 twice"), std::string::npos) << q;
+  EXPECT_NE(q.find("1 values, but combine = \"zip\" needs as many"), std::string::npos) << q;
+  EXPECT_NE(
+      problems("[campaign]\nprotocol = \"ucs.toml\"\nseeds = 2\n").find("missing campaign.name"),
+      std::string::npos);
+  EXPECT_NE(problems("[campaign\n").find("not valid TOML"), std::string::npos);
+}
+
+TEST(CampaignStatistics, StudentQuantilesMatchTheTables) {
+  // t(0.975, df), e.g. Abramowitz & Stegun table 26.10 (to the 4 decimals they give).
+  const std::pair<std::size_t, double> table[] = {{1, 12.7062}, {2, 4.3027},  {3, 3.1824},
+                                                  {4, 2.7764},  {5, 2.5706},  {9, 2.2622},
+                                                  {10, 2.2281}, {30, 2.0423}, {120, 1.9799}};
+  for (const auto& [df, t] : table) EXPECT_NEAR(studentT975(df), t, 5e-5) << "df " << df;
+  EXPECT_NEAR(studentT975(100000), 1.95996, 1e-4);  // the normal quantile
+  EXPECT_THROW(studentT975(0), std::invalid_argument);
+}
+
+TEST(CampaignStatistics, SummaryOfAnEnsemble) {
+  const Summary s = summarize({9.77, 11.3, 11.75, 10.2, 10.9});
+  EXPECT_EQ(s.n, 5u);
+  EXPECT_NEAR(s.mean, 10.784, 1e-12);
+  double ss = 0.0;
+  for (double v : {9.77, 11.3, 11.75, 10.2, 10.9}) ss += (v - 10.784) * (v - 10.784);
+  EXPECT_NEAR(s.std, std::sqrt(ss / 4.0), 1e-12);
+  EXPECT_NEAR(s.high - s.mean, 2.7764 * s.std / std::sqrt(5.0), 1e-4);
+  EXPECT_NEAR(s.mean - s.low, s.high - s.mean, 1e-12);
+  const Summary one = summarize({3.0});
+  EXPECT_EQ(one.n, 1u);
+  EXPECT_EQ(one.std, 0.0);
+  EXPECT_TRUE(std::isnan(one.low));
+}
