@@ -16,6 +16,14 @@ cmd=${1:-}; dir=${2:-}
 pids() { for f in "$dir"/ctld.pid "$dir"/d.pid "$dir"/munge/munged.pid; do [ -s "$f" ] && cat "$f"; done; true; }
 
 stop() {
+  # The jobs first (a test that failed may leave some queued or running), then the daemons.
+  if [ -s "$dir/ctld.pid" ] && kill -0 "$(cat "$dir/ctld.pid")" 2>/dev/null; then
+    SLURM_CONF="$dir/slurm.conf" scancel --user="$(id -un)" 2>/dev/null || true
+    for i in $(seq 1 50); do
+      [ -z "$(SLURM_CONF="$dir/slurm.conf" squeue -h -o %i 2>/dev/null)" ] && break
+      sleep 0.2
+    done
+  fi
   for p in $(pids); do kill "$p" 2>/dev/null || true; done
   # The daemons take a moment to go; wait for each, then make sure.
   for i in $(seq 1 50); do
