@@ -85,9 +85,12 @@ std::vector<std::string> checkTasks(const campaign::Campaign& c) {
   return hashes;
 }
 
+// What a notebook is on disk besides its file's name.
+constexpr const char* kNotebookParts[] = {"", "-wal", "-shm", ".files"};
+
 // Moves a notebook (closed) and its files; across file systems by copying.
 void moveNotebook(const std::string& from, const std::string& to) {
-  for (const std::string suffix : {"", "-wal", "-shm", ".files"}) {
+  for (const std::string suffix : kNotebookParts) {
     const fs::path a = from + suffix, b = to + suffix;
     if (!fs::exists(a)) continue;
     fs::remove_all(b);
@@ -101,7 +104,7 @@ void moveNotebook(const std::string& from, const std::string& to) {
 }
 
 void removeNotebook(const std::string& path) {
-  for (const std::string suffix : {"", "-wal", "-shm", ".files"}) fs::remove_all(path + suffix);
+  for (const std::string suffix : kNotebookParts) fs::remove_all(path + suffix);
 }
 
 // Where a task's shard was made: what its task wrote beside it (the scheduler's ids).
@@ -116,10 +119,10 @@ notebook::Provenance originOf(const std::string& dir, int task) {
   return p;
 }
 
-// Merges a task's shard into the lab and notes its run; a completed shard is removed (the
-// lab has all of it), one that failed stays, for a rerun to resume from its checkpoint.
-campaign::TaskState collectShard(notebook::Notebook& lab, std::int64_t campaign_id,
-                                 const campaign::Campaign& c, campaign::TaskState t,
+// Merges a task's shard into the lab and returns the task with its run there; a completed
+// shard is removed (the lab has all of it), one that failed stays, for a rerun to resume
+// from its checkpoint.
+campaign::TaskState collectShard(notebook::Notebook& lab, campaign::TaskState t,
                                  const std::string& dir) {
   const std::string shard = shardOf(dir, t.task.index);
   if (!fs::exists(shard)) return t;
@@ -140,7 +143,6 @@ campaign::TaskState collectShard(notebook::Notebook& lab, std::int64_t campaign_
     t.status = q.text(1);
     t.reason = q.text(2);
   }
-  campaign::recordTask(lab, campaign_id, c, t);
   if (status == "completed") {
     removeNotebook(shard);
     for (const char* ext : {".log", ".origin"}) {
@@ -253,8 +255,8 @@ std::optional<Opened> openCampaign(const CampaignOptions& o) {
 std::vector<campaign::TaskState> collectAll(notebook::Notebook& lab, std::int64_t id,
                                             const Opened& x, const std::string& dir) {
   std::vector<campaign::TaskState> states = campaign::survey(lab, x.c, x.hashes);
-  for (auto& t : states) t = collectShard(lab, id, x.c, t, dir);
-  for (const auto& t : states) {
+  for (auto& t : states) {
+    t = collectShard(lab, t, dir);
     if (t.run > 0) campaign::recordTask(lab, id, x.c, t);
   }
   campaign::updateStatistics(lab, id, x.c);
@@ -305,7 +307,8 @@ int runLocal(const CampaignOptions& o, const Opened& x) {
     if (it == running.end()) continue;
     const auto [k, t0] = it->second;
     running.erase(it);
-    campaign::TaskState t = collectShard(lab, id, c, queue[k], dir);
+    const campaign::TaskState t = collectShard(lab, queue[k], dir);
+    if (t.run > 0) campaign::recordTask(lab, id, c, t);
     states[static_cast<std::size_t>(t.task.index)] = t;
     progress.ended(t.status == "completed",
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());

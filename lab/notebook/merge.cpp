@@ -72,6 +72,13 @@ MergeOutcome mergeNotebook(Notebook& into, const std::string& source, const Prov
   const std::string source_files = fs::absolute(source).string() + ".files";
   const std::vector<std::string> run_columns = columnsOf(db, "runs", {"id"});
   const std::vector<std::string> wave_columns = columnsOf(db, "waves", {"id", "run_id"});
+  std::vector<std::pair<std::string, std::vector<std::string>>> run_tables;
+  for (const char* table : kRunTables)
+    run_tables.emplace_back(table, columnsOf(db, table, {"run_id"}));
+  std::vector<std::pair<std::string, std::vector<std::string>>> wave_tables;
+  for (const char* table : {"traces", "picks"}) {
+    wave_tables.emplace_back(table, columnsOf(db, table, {"wave_id"}));
+  }
 
   MergeOutcome out;
   std::vector<fs::path> copied;    // removed if the merge fails
@@ -111,10 +118,9 @@ MergeOutcome mergeNotebook(Notebook& into, const std::string& source, const Prov
           .bind(1, old_id)
           .run();
       const std::int64_t id = db.lastInsertId();
-      for (const char* table : kRunTables) {
-        const auto columns = columnsOf(db, table, {"run_id"});
-        db.prepare(std::string("INSERT INTO main.") + table + " (run_id, " + joined(columns) +
-                   ") SELECT ?, " + joined(columns) + " FROM src." + table + " WHERE run_id = ?")
+      for (const auto& [table, columns] : run_tables) {
+        db.prepare("INSERT INTO main." + table + " (run_id, " + joined(columns) + ") SELECT ?, " +
+                   joined(columns) + " FROM src." + table + " WHERE run_id = ?")
             .bind(1, id)
             .bind(2, old_id)
             .run();
@@ -131,11 +137,10 @@ MergeOutcome mergeNotebook(Notebook& into, const std::string& source, const Prov
             .run();
         wave_ids[waves.integer(0)] = db.lastInsertId();
       }
-      for (const char* table : {"traces", "picks"}) {
-        const auto columns = columnsOf(db, table, {"wave_id"});
-        auto copy = db.prepare(std::string("INSERT INTO main.") + table + " (wave_id, " +
-                               joined(columns) + ") SELECT ?, " + joined(columns) + " FROM src." +
-                               table + " WHERE wave_id = ?");
+      for (const auto& [table, columns] : wave_tables) {
+        auto copy = db.prepare("INSERT INTO main." + table + " (wave_id, " + joined(columns) +
+                               ") SELECT ?, " + joined(columns) + " FROM src." + table +
+                               " WHERE wave_id = ?");
         for (const auto& [from, to] : wave_ids) copy.bind(1, to).bind(2, from).run();
       }
       // The run's files, and the paths the notebook keeps of them.

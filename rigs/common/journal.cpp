@@ -63,7 +63,6 @@ Journal Journal::resuming(Options o) {
   j.resume_unit_ = std::stoi(m["unit"]);
   j.resume_phase_ = m["phase"] == "mid" ? Phase::Mid : Phase::End;
   j.resume_seq_ = std::stoull(m["seq"].empty() ? "0" : m["seq"]);
-  j.seq_ = j.resume_seq_;  // the resumed run numbers its checkpoints on
   if (j.resume_phase_ == Phase::Mid)
     j.last_mid_ = j.file(j.resume_unit_, Phase::Mid, j.resume_seq_);
   j.resume_mark_ = m["mark"];
@@ -94,7 +93,7 @@ void Journal::write(int ordinal, Phase phase, std::string_view name, const std::
   // The checkpoint first, under a name of its own; the manifest's rename then makes it the
   // one to resume from, with the notebook mark taken with it. A kill between the two leaves
   // the manifest naming the previous checkpoint, which is still there.
-  const std::uint64_t seq = ++seq_;
+  const std::uint64_t seq = resume_seq_ + writes_ + 1;
   const std::string path = file(ordinal, phase, seq);
   writeAtomically(path, data);
   std::ostringstream manifest;

@@ -68,8 +68,7 @@ class Journal {
   bool replaying_ = false;
   int resume_unit_ = -1;  // the unit the checkpoint is of
   Phase resume_phase_ = Phase::End;
-  std::uint64_t resume_seq_ = 0;  // its number
-  std::uint64_t seq_ = 0;         // the number of the last checkpoint written
+  std::uint64_t resume_seq_ = 0;  // its number (a resumed run numbers its own on from it)
   std::string last_mid_;          // the mid checkpoint the manifest names, if any
   std::string resume_mark_, resume_point_;
   double write_seconds_ = 0.0;
@@ -127,20 +126,12 @@ class Journal::Unit {
     return ordinal_ < j_->resume_unit_ ||
            (ordinal_ == j_->resume_unit_ && j_->resume_phase_ == Phase::End);
   }
-  template <class T>
-  static void one(ArchiveWriter& w, T& x) {
-    if constexpr (requires { x.journal(w); }) {
-      x.journal(w);
+  template <class Archive, class T>
+  static void one(Archive& ar, T& x) {
+    if constexpr (requires { x.journal(ar); }) {
+      x.journal(ar);
     } else {
-      w("state", x);
-    }
-  }
-  template <class T>
-  static void one(ArchiveReader& r, T& x) {
-    if constexpr (requires { x.journal(r); }) {
-      x.journal(r);
-    } else {
-      r("state", x);
+      ar("state", x);
     }
   }
   template <class... T>

@@ -481,38 +481,31 @@ void expectSameRun(const std::string& reference, const std::string& resumed) {
             std::vector<std::string>{"1|"});
 }
 
+// `rocklab run` of a quick protocol on one thread, checkpointing every 0.2 s, with `sets`.
+std::vector<std::string> checkpointedRun(const std::string& protocol, const std::string& lab,
+                                         const std::vector<std::string>& sets) {
+  std::vector<std::string> args = {"run",
+                                   sourceDir() + "/protocols/" + protocol + ".toml",
+                                   "--quiet",
+                                   "--threads",
+                                   "1",
+                                   "--set",
+                                   "output.checkpoint_every_s=0.2"};
+  for (const auto& s : sets) args.insert(args.end(), {"--set", s});
+  args.insert(args.end(), {"--lab", lab});
+  return args;
+}
+
 std::vector<std::string> quickHydrostatic(const std::string& lab) {
-  return {"run",
-          sourceDir() + "/protocols/hydrostatic-quick.toml",
-          "--quiet",
-          "--threads",
-          "1",
-          "--set",
-          "sample.count=600",
-          "--set",
-          "output.checkpoint_every_s=0.2",
-          "--lab",
-          lab};
+  return checkpointedRun("hydrostatic-quick", lab, {"sample.count=600"});
 }
 
 // A biaxial test in the permeameter: the fluid's networks and pressures (applied to the
 // particles) carried through the checkpoints of the loading loop.
 std::vector<std::string> quickPermeameter(const std::string& lab) {
-  return {"run",
-          sourceDir() + "/protocols/permeameter-anisotropy-2d-quick.toml",
-          "--quiet",
-          "--threads",
-          "1",
-          "--set",
-          "flow.direction=along",
-          "--set",
-          "flow.apply_forces=true",
-          "--set",
-          "flow.compare_solvers=false",
-          "--set",
-          "output.checkpoint_every_s=0.2",
-          "--lab",
-          lab};
+  return checkpointedRun(
+      "permeameter-anisotropy-2d-quick", lab,
+      {"flow.direction=along", "flow.apply_forces=true", "flow.compare_solvers=false"});
 }
 
 double randomDelay(double lo, double hi) {
