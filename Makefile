@@ -1,7 +1,7 @@
 # Front door: `make demo` and `make test` install what is missing, build and run.
 # The build itself is CMake (CMakePresets.json); this file only strings the steps together.
 
-PACKAGES := build-essential cmake pkg-config git \
+PACKAGES := build-essential cmake ninja-build pkg-config git \
   libeigen3-dev libcgal-dev libvtk9-dev libosmesa6-dev libfftw3-dev \
   libsuitesparse-dev libopenblas0-serial \
   libsqlite3-dev sqlite3 libgtest-dev libtoml11-dev libcli11-dev libbenchmark-dev xz-utils \
@@ -29,8 +29,15 @@ deps:
 	  DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -q --no-install-recommends $$missing; \
 	fi
 
+# A build folder an older rocklab configured for Make is configured anew for Ninja.
+define configure
+	@if [ -f build/$(1)/CMakeCache.txt ] && ! grep -q 'CMAKE_GENERATOR:INTERNAL=Ninja' build/$(1)/CMakeCache.txt; then \
+	  rm -rf build/$(1)/CMakeCache.txt build/$(1)/CMakeFiles; fi
+	cmake --preset $(1)
+endef
+
 build: deps
-	cmake --preset $(PRESET)
+	$(call configure,$(PRESET))
 	cmake --build --preset $(PRESET)
 
 # The main job: the quick oedometer protocol (a cemented sample formed under stress, then
@@ -56,7 +63,7 @@ test-slurm: build
 
 # The unit tests under address and undefined-behaviour sanitizers.
 test-sanitize: deps
-	cmake --preset sanitize
+	$(call configure,sanitize)
 	cmake --build --preset sanitize
 	ctest --preset sanitize
 

@@ -13,6 +13,7 @@
 #include <vtkPlotPoints.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
 #include <vtkVector.h>
@@ -32,10 +33,59 @@ constexpr unsigned char kPalette[][3] = {{0, 0, 0},       {230, 159, 0}, {86, 18
                                          {0, 158, 115},   {213, 94, 0},  {0, 114, 178},
                                          {204, 121, 167}, {240, 228, 66}};
 
+bool hasSpread(const Series& s) {
+  return !s.x.empty() && s.low.size() == s.x.size() && s.high.size() == s.x.size();
+}
+
+vtkSmartPointer<vtkTable> columns(const std::vector<const std::vector<double>*>& cols,
+                                  const std::vector<std::string>& names) {
+  auto table = vtkSmartPointer<vtkTable>::New();
+  for (const std::string& name : names) {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name.c_str());
+    table->AddColumn(a);
+  }
+  table->SetNumberOfRows(static_cast<vtkIdType>(cols.front()->size()));
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    for (std::size_t i = 0; i < cols[c]->size(); ++i) {
+      table->SetValue(static_cast<vtkIdType>(i), static_cast<vtkIdType>(c), (*cols[c])[i]);
+    }
+  }
+  return table;
+}
+
+// An ensemble's spread, drawn under its series in its colour: a translucent band between low
+// and high about a line; a vertical bar through each point.
+void drawSpread(vtkChartXY* chart, const Series& s, const unsigned char* c, std::size_t k) {
+  std::string tag = "#";
+  tag += std::to_string(k);
+  if (!s.markers) {
+    const auto table = columns({&s.x, &s.low, &s.high}, {"x" + tag, "low" + tag, "high" + tag});
+    vtkPlot* band = chart->AddPlot(vtkChart::AREA);
+    band->SetInputData(table);
+    band->SetInputArray(0, "x" + tag);
+    band->SetInputArray(1, "low" + tag);
+    band->SetInputArray(2, "high" + tag);
+    band->SetColor(c[0], c[1], c[2], 60);
+    band->SetLegendVisibility(false);
+    return;
+  }
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    if (!(s.high[i] > s.low[i])) continue;
+    const std::vector<double> x = {s.x[i], s.x[i]}, y = {s.low[i], s.high[i]};
+    const auto table = columns({&x, &y}, {"bar x" + tag, "bar y" + tag});
+    vtkPlot* bar = chart->AddPlot(vtkChart::LINE);
+    bar->SetInputData(table, 0, 1);
+    bar->SetColor(c[0], c[1], c[2], 255);
+    bar->SetWidth(1.5f);
+    bar->SetLegendVisibility(false);
+  }
+}
+
 void writeCsv(const Figure& f, const std::string& path) {
   std::ofstream out(path);
   out.precision(10);
-  out << "panel,series,x,y\n";
+  out << "panel,series,x,y,low,high\n";
   for (std::size_t p = 0; p < f.panels.size(); ++p) {
     for (const Series& s : f.panels[p].series) {
       std::string label = s.label;
@@ -43,7 +93,12 @@ void writeCsv(const Figure& f, const std::string& path) {
         if (c == ',' || c == '"') c = ' ';
       }
       for (std::size_t k = 0; k < s.x.size(); ++k) {
-        out << p + 1 << "," << label << "," << s.x[k] << "," << s.y[k] << "\n";
+        out << p + 1 << "," << label << "," << s.x[k] << "," << s.y[k] << ",";
+        if (hasSpread(s))
+          out << s.low[k] << "," << s.high[k];
+        else
+          out << ",";
+        out << "\n";
       }
     }
   }
@@ -85,6 +140,9 @@ void renderFigure(const Figure& f, const std::string& dir) {
         if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
         lo[0] = std::min(lo[0], s.x[i]), hi[0] = std::max(hi[0], s.x[i]);
         lo[1] = std::min(lo[1], s.y[i]), hi[1] = std::max(hi[1], s.y[i]);
+        if (hasSpread(s) && std::isfinite(s.low[i]) && std::isfinite(s.high[i])) {
+          lo[1] = std::min(lo[1], s.low[i]), hi[1] = std::max(hi[1], s.high[i]);
+        }
       }
     }
     for (int a = 0; a < 2 && hi[0] >= lo[0]; ++a) {
@@ -96,20 +154,11 @@ void renderFigure(const Figure& f, const std::string& dir) {
     for (std::size_t k = 0; k < panel.series.size(); ++k) {
       const Series& s = panel.series[k];
       if (s.x.empty()) continue;
-      vtkNew<vtkTable> table;
-      vtkNew<vtkDoubleArray> x, y;
-      x->SetName((panel.x_label + "#" + std::to_string(k)).c_str());
-      y->SetName(s.label.c_str());
-      table->AddColumn(x);
-      table->AddColumn(y);
-      table->SetNumberOfRows(static_cast<vtkIdType>(s.x.size()));
-      for (std::size_t i = 0; i < s.x.size(); ++i) {
-        table->SetValue(static_cast<vtkIdType>(i), 0, s.x[i]);
-        table->SetValue(static_cast<vtkIdType>(i), 1, s.y[i]);
-      }
+      const auto* c = kPalette[k % 8];
+      if (hasSpread(s)) drawSpread(chart, s, c, k);
+      const auto table = columns({&s.x, &s.y}, {panel.x_label + "#" + std::to_string(k), s.label});
       vtkPlot* plot = chart->AddPlot(s.markers ? vtkChart::POINTS : vtkChart::LINE);
       plot->SetInputData(table, 0, 1);
-      const auto* c = kPalette[k % 8];
       plot->SetColor(c[0], c[1], c[2], 255);
       plot->SetWidth(s.markers ? 1.0f : 2.0f);
       plot->SetLabel(s.label);

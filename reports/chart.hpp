@@ -11,6 +11,9 @@ struct Series {
   std::string label;
   std::vector<double> x, y;
   bool markers = false;  // points (e.g. a value from the paper) instead of a line
+  // A spread about y (an ensemble's, one per x; empty: none): a band about a line, error
+  // bars on points.
+  std::vector<double> low, high;
 };
 
 struct Panel {
@@ -25,7 +28,8 @@ struct Figure {
   std::vector<Panel> panels;
 };
 
-// Writes dir/<id>.png and dir/<id>.csv (columns panel, series, x, y).
+// Writes dir/<id>.png and dir/<id>.csv (columns panel, series, x, y, low, high; the last two
+// empty without a spread).
 void renderFigure(const Figure& f, const std::string& dir);
 
 }  // namespace rocklab::reports

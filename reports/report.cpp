@@ -156,13 +156,7 @@ void figures(std::ostream& body, const std::vector<RunData>& runs, const Paper& 
     }
     if (of_rig.empty()) continue;
     for (const Figure& f : entry.build(of_rig, paper)) {
-      renderFigure(f, out);
-      summary.files.push_back(f.id + ".png");
-      summary.files.push_back(f.id + ".csv");
-      body << "<figure><img src=\"" << f.id << ".png\" alt=\"" << html(f.title)
-           << "\"><figcaption><b>" << html(f.title) << ".</b> " << html(f.caption)
-           << " Data: <a href=\"" << f.id << ".csv\">" << f.id
-           << ".csv</a>.</figcaption></figure>\n";
+      writeFigure(f, out, body, summary);
       ++count;
     }
   }
@@ -278,6 +272,16 @@ void runDetails(std::ostream& body, const RunData& r, const Paper& paper) {
 }
 
 }  // namespace
+
+void writeFigure(const Figure& f, const std::string& out, std::ostream& body,
+                 ReportSummary& summary) {
+  renderFigure(f, out);
+  summary.files.push_back(f.id + ".png");
+  summary.files.push_back(f.id + ".csv");
+  body << "<figure><img src=\"" << f.id << ".png\" alt=\"" << html(f.title) << "\"><figcaption><b>"
+       << html(f.title) << ".</b> " << html(f.caption) << " Data: <a href=\"" << f.id << ".csv\">"
+       << f.id << ".csv</a>.</figcaption></figure>\n";
+}
 
 ReportSummary writeReport(const ReportOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -3,8 +3,11 @@
 // for ParaView from the runs' state frames.
 
 #include <cstdint>
+#include <ostream>
 #include <string>
 #include <vector>
+
+#include "reports/chart.hpp"
 
 namespace rocklab::reports {
 
@@ -21,6 +24,11 @@ struct ReportSummary {
   std::vector<std::string> files;  // every file written, relative to `out`
   double seconds = 0.0;
 };
+
+// Renders a figure into `out` (PNG and CSV, noted in `summary`) and writes its HTML block,
+// caption and link to its data, into `body`.
+void writeFigure(const Figure& f, const std::string& out, std::ostream& body,
+                 ReportSummary& summary);
 
 // Writes out/index.html with the figures (PNG + CSV), snapshots and tables.
 ReportSummary writeReport(const ReportOptions& o);

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lab/campaign/statistics.hpp"
 #include "reports/chart.hpp"
 #include "reports/html.hpp"
 #include "reports/key_results.hpp"
@@ -16,8 +17,8 @@ namespace rocklab::reports {
 
 namespace {
 
-// The keys whose values differ between the runs: what the study varied. The seed of a study
-// over seeds counts; the run's own bookkeeping (threads) does not change results.
+// The keys whose values differ between the runs: what the study varied, and the seed of a
+// study over seeds; the run's own bookkeeping (threads) does not change results.
 std::vector<std::string> variedKeys(const std::vector<RunData>& runs) {
   std::vector<std::string> keys;
   for (const auto& [key, value, unit] : runs.front().params) {
@@ -29,6 +30,12 @@ std::vector<std::string> variedKeys(const std::vector<RunData>& runs) {
       }
     }
   }
+  return keys;
+}
+
+// The keys that make a setting: the varied ones but the seed, whose runs are its ensemble.
+std::vector<std::string> withoutSeed(std::vector<std::string> keys) {
+  keys.erase(std::remove(keys.begin(), keys.end(), "protocol.seed"), keys.end());
   return keys;
 }
 
@@ -49,26 +56,34 @@ Figure costAccuracyChart(const Study& s) {
   std::string varied;
   for (const std::string& k : s.varied) varied += (varied.empty() ? "" : ", ") + k;
   f.title = s.protocol + ": what accuracy costs" + (varied.empty() ? "" : " (" + varied + ")");
+  const bool seeds = s.seeds > 1;
   f.caption =
-      "Each run of the study: its wall time against its error, the largest relative deviation "
-      "of a key result from the finest setting (run " +
-      std::to_string(s.points.front().run) +
-      "). The line joins the Pareto front: the runs no faster run matches in accuracy. The "
+      "Each setting of the study: its wall time against its error, the largest relative "
+      "deviation of a key result from the finest setting (run " +
+      std::to_string(s.points.front().run) + ")" +
+      (seeds ? " beyond the seed scatter: over " + std::to_string(s.seeds) +
+                   " seeds per setting, a deviation inside Welch's 95% interval of the "
+                   "difference of the means counts as none, and times are means"
+             : "") +
+      ". The line joins the Pareto front: the settings no faster one matches in accuracy. The "
       "flat line is the tolerance.";
-  Panel p{"wall time (s)", "largest deviation of a key result (%)", {}};
+  Panel p{"wall time (s)",
+          seeds ? "largest deviation beyond the seed scatter (%)"
+                : "largest deviation of a key result (%)",
+          {}};
   Series all{"settings", {}, {}, true}, front{"Pareto front", {}, {}, false},
       tol{"tolerance " + num(100.0 * s.tolerance, 3) + "%", {}, {}, false};
   std::vector<const StudyPoint*> sorted;
   for (const StudyPoint& q : s.points) {
-    if (!std::isfinite(q.error)) continue;
-    all.x.push_back(q.wall_seconds), all.y.push_back(100.0 * q.error);
+    if (!std::isfinite(q.loss)) continue;
+    all.x.push_back(q.wall_seconds), all.y.push_back(100.0 * q.loss);
     sorted.push_back(&q);
   }
   std::sort(sorted.begin(), sorted.end(), [](const StudyPoint* a, const StudyPoint* b) {
     return a->wall_seconds < b->wall_seconds;
   });
   for (const StudyPoint* q : sorted) {
-    if (q->pareto) front.x.push_back(q->wall_seconds), front.y.push_back(100.0 * q->error);
+    if (q->pareto) front.x.push_back(q->wall_seconds), front.y.push_back(100.0 * q->loss);
   }
   if (!all.x.empty()) {
     tol.x = {*std::min_element(all.x.begin(), all.x.end()),
@@ -100,7 +115,7 @@ Study evaluateStudy(const std::string& lab, const std::vector<std::int64_t>& ids
                                   r.protocol + "', not '" + s.protocol + "'");
     }
   }
-  s.varied = variedKeys(runs);
+  s.varied = withoutSeed(variedKeys(runs));
   const std::vector<KeyValue> ref = keyResults(runs.front());
   if (ref.empty()) {
     throw std::invalid_argument("study: protocol '" + s.protocol +
@@ -108,22 +123,63 @@ Study evaluateStudy(const std::string& lab, const std::vector<std::int64_t>& ids
                                 "compare");
   }
   for (const KeyValue& k : ref) s.key_names.push_back(k.name), s.key_units.push_back(k.unit);
+  // Settings in order of their first run; a setting's runs differ only in their seed.
+  std::vector<std::vector<const RunData*>> settings;
   for (const RunData& r : runs) {
+    auto same = std::find_if(settings.begin(), settings.end(), [&](const auto& g) {
+      return settingOf(*g.front(), s.varied) == settingOf(r, s.varied);
+    });
+    if (same == settings.end()) {
+      settings.push_back({&r});
+    } else {
+      same->push_back(&r);
+    }
+  }
+  std::vector<std::vector<campaign::Summary>> summaries;  // per setting, per key result
+  for (const auto& group : settings) {
     StudyPoint q;
-    q.run = r.id, q.setting = settingOf(r, s.varied), q.status = r.status;
-    q.wall_seconds = r.wall_seconds;
-    const std::vector<KeyValue> keys = keyResults(r);
-    for (std::size_t k = 0; k < keys.size(); ++k) {
-      q.values.push_back(keys[k].value);
+    q.run = group.front()->id, q.setting = settingOf(*group.front(), s.varied);
+    q.status = "completed";
+    std::vector<std::vector<double>> values(s.key_names.size());
+    bool complete = true;
+    for (const RunData* r : group) {
+      q.runs.push_back(r->id);
+      q.wall_seconds += r->wall_seconds / static_cast<double>(group.size());
+      if (r->status != "completed" && q.status == "completed") q.status = r->status;
+      const std::vector<KeyValue> keys = keyResults(*r);
+      for (std::size_t k = 0; k < keys.size(); ++k) {
+        if (keys[k].value) {
+          values[k].push_back(*keys[k].value);
+        } else {
+          complete = false;
+        }
+      }
+    }
+    s.seeds = std::max(s.seeds, group.size());
+    summaries.emplace_back();
+    for (const auto& v : values) {
+      summaries.back().push_back(campaign::summarize(v));
+      const campaign::Summary& m = summaries.back().back();
+      q.values.push_back(m.n ? std::optional<double>(m.mean) : std::nullopt);
+      q.spread.push_back(m.n > 1 ? std::optional<double>(m.std) : std::nullopt);
+    }
+    for (std::size_t k = 0; k < s.key_names.size(); ++k) {
+      const campaign::Summary& mine = summaries.back()[k];
+      const campaign::Summary& finest = summaries.front()[k];
       std::optional<double> dev;
-      if (keys[k].value && ref[k].value) {
-        const double d = std::abs(*keys[k].value - *ref[k].value);
-        dev = *ref[k].value != 0.0 ? d / std::abs(*ref[k].value) : d;
+      bool inside = false;
+      if (mine.n && finest.n) {
+        const double d = std::abs(mine.mean - finest.mean);
+        dev = finest.mean != 0.0 ? d / std::abs(finest.mean) : d;
+        const campaign::Difference diff = campaign::compareMeans(finest, mine);
+        inside = summaries.size() > 1 && diff.known && !diff.resolved();
       }
       q.deviation.push_back(dev);
+      q.within_scatter.push_back(inside);
       q.error = dev ? std::max(q.error, *dev) : INFINITY;
+      q.loss = dev ? std::max(q.loss, inside ? 0.0 : *dev) : INFINITY;
     }
-    if (r.status != "completed") q.error = INFINITY;
+    if (q.status != "completed" || !complete) q.error = q.loss = INFINITY;
     s.points.push_back(std::move(q));
   }
   // The Pareto front: scanning from the fastest, a run is on it when it is more accurate than
@@ -137,10 +193,10 @@ Study evaluateStudy(const std::string& lab, const std::vector<std::int64_t>& ids
   bool found = false;
   for (std::size_t k : order) {
     StudyPoint& q = s.points[k];
-    if (!std::isfinite(q.error)) continue;
-    q.pareto = q.error < best;
-    best = std::min(best, q.error);
-    if (!found && q.error <= tolerance) s.cheapest = static_cast<int>(k), found = true;
+    if (!std::isfinite(q.loss)) continue;
+    q.pareto = q.loss < best;
+    best = std::min(best, q.loss);
+    if (!found && q.loss <= tolerance) s.cheapest = static_cast<int>(k), found = true;
   }
   return s;
 }
@@ -152,33 +208,55 @@ std::string studySummary(const Study& s) {
   o << "cheapest within " << 100.0 * s.tolerance << "%: run " << c.run << " (" << c.setting << "), "
     << c.wall_seconds << " s against " << s.points.front().wall_seconds
     << " s for the finest, largest deviation " << 100.0 * c.error << "%";
+  if (s.seeds > 1) {
+    o << ", " << 100.0 * c.loss << "% beyond the scatter of " << s.seeds << " seeds";
+  }
   return o.str();
 }
+
+namespace {
+
+std::string runIds(const StudyPoint& q) {
+  std::string ids;
+  for (std::int64_t id : q.runs) ids += (ids.empty() ? "" : " ") + std::to_string(id);
+  return ids;
+}
+
+void writeStudyCsv(const Study& s, const std::string& path) {
+  std::ofstream csv(path);
+  csv.precision(10);
+  csv << "runs,setting,status,wall_seconds,error,loss,pareto";
+  for (const std::string& k : s.key_names) {
+    csv << "," << k << "," << k << "_std," << k << "_deviation," << k << "_within_scatter";
+  }
+  csv << "\n";
+  for (const StudyPoint& q : s.points) {
+    std::string setting = q.setting;
+    std::replace(setting.begin(), setting.end(), ',', ';');
+    csv << runIds(q) << "," << setting << "," << q.status << "," << q.wall_seconds << "," << q.error
+        << "," << q.loss << "," << q.pareto;
+    for (std::size_t k = 0; k < s.key_names.size(); ++k) {
+      csv << ",";
+      if (q.values[k]) csv << *q.values[k];
+      csv << ",";
+      if (q.spread[k]) csv << *q.spread[k];
+      csv << ",";
+      if (q.deviation[k]) csv << *q.deviation[k];
+      csv << "," << q.within_scatter[k];
+    }
+    csv << "\n";
+  }
+  if (!csv) throw std::runtime_error("cannot write '" + path + "'");
+}
+
+}  // namespace
 
 void writeStudyReport(const Study& s, const std::string& out) {
   std::filesystem::create_directories(out);
   const Figure chart = costAccuracyChart(s);
   renderFigure(chart, out);
-
-  std::ofstream csv(out + "/study.csv");
-  csv.precision(10);
-  csv << "run,setting,status,wall_seconds,error,pareto";
-  for (const std::string& k : s.key_names) csv << "," << k << "," << k << "_deviation";
-  csv << "\n";
-  for (const StudyPoint& q : s.points) {
-    std::string setting = q.setting;
-    std::replace(setting.begin(), setting.end(), ',', ';');
-    csv << q.run << "," << setting << "," << q.status << "," << q.wall_seconds << "," << q.error
-        << "," << q.pareto;
-    for (std::size_t k = 0; k < s.key_names.size(); ++k) {
-      csv << ",";
-      if (q.values[k]) csv << *q.values[k];
-      csv << ",";
-      if (q.deviation[k]) csv << *q.deviation[k];
-    }
-    csv << "\n";
-  }
-  if (!csv) throw std::runtime_error("cannot write '" + out + "/study.csv'");
+  writeStudyCsv(s, out + "/study.csv");
+  const bool seeds = s.seeds > 1;
 
   std::ostringstream b;
   b << "<h1>Accuracy study: " << html(s.protocol) << "</h1>\n<p>Lab notebook <code>" << html(s.lab)
@@ -187,19 +265,33 @@ void writeStudyReport(const Study& s, const std::string& out) {
     b << (k ? ", " : "") << "<code>" << html(s.varied[k]) << "</code>";
   }
   if (s.varied.empty()) b << "nothing (repeats of one setting)";
-  b << ". The finest setting is run " << s.points.front().run
-    << "; a run's error is the largest relative deviation of a key result from it.</p>\n";
+  b << ". The finest setting is run"
+    << (seeds ? "s " + runIds(s.points.front()) : " ") +
+           (seeds ? "" : std::to_string(s.points.front().run))
+    << "; a setting's error is the largest relative deviation of a key result from it.</p>\n";
+  if (seeds) {
+    b << "<p>Each setting ran at " << s.seeds
+      << " seeds; its key results are the means over them, shown with their standard "
+         "deviation. A deviation inside the seed scatter &mdash; Welch's 95% interval of the "
+         "difference of the two means contains zero &mdash; is not a loss of accuracy: the "
+         "seeds cannot tell the two settings apart, and such a deviation is marked "
+         "<em>inside the scatter</em> and counts as none in the setting's loss, which ranks "
+         "the settings and picks the cheapest.</p>\n";
+  }
   const StudyPoint& c = s.points[s.cheapest];
   b << "<p><strong>Cheapest within " << num(100.0 * s.tolerance, 3) << "%:</strong> run " << c.run
     << " (" << html(c.setting) << "), " << num(c.wall_seconds, 4) << " s against "
     << num(s.points.front().wall_seconds, 4) << " s for the finest ("
     << num(s.points.front().wall_seconds / std::max(c.wall_seconds, 1e-9), 3)
-    << "&times; faster), largest deviation " << percent(c.error) << ".</p>\n";
+    << "&times; faster), largest deviation " << percent(c.error);
+  if (seeds) b << ", " << percent(c.loss) << " beyond the seed scatter";
+  b << ".</p>\n";
   b << "<figure><img src=\"cost-accuracy.png\" alt=\"cost-accuracy chart\"><figcaption>"
     << html(chart.caption) << " Data: <a href=\"cost-accuracy.csv\">cost-accuracy.csv</a>, "
     << "<a href=\"study.csv\">study.csv</a>.</figcaption></figure>\n";
-  b << "<h2>Runs</h2>\n<table><tr><th>run</th><th>setting</th><th>status</th>"
-       "<th>wall time (s)</th><th>error</th><th>Pareto</th>";
+  b << "<h2>Settings</h2>\n<table><tr><th>run" << (seeds ? "s" : "")
+    << "</th><th>setting</th><th>status</th><th>wall time (s)</th><th>error</th>"
+    << (seeds ? "<th>loss</th>" : "") << "<th>Pareto</th>";
   for (std::size_t k = 0; k < s.key_names.size(); ++k) {
     b << "<th>" << html(s.key_names[k])
       << (s.key_units[k].empty() || s.key_units[k] == "-" ? "" : " (" + html(s.key_units[k]) + ")")
@@ -207,14 +299,18 @@ void writeStudyReport(const Study& s, const std::string& out) {
   }
   b << "</tr>\n";
   for (const StudyPoint& q : s.points) {
-    b << "<tr><td>" << q.run << "</td><td>" << html(q.setting) << "</td><td class=\"status-"
+    b << "<tr><td>" << runIds(q) << "</td><td>" << html(q.setting) << "</td><td class=\"status-"
       << q.status << "\">" << q.status << "</td><td class=\"n\">" << num(q.wall_seconds, 4)
-      << "</td><td class=\"n\">" << percent(q.error) << "</td><td>" << (q.pareto ? "yes" : "")
-      << "</td>";
+      << "</td><td class=\"n\">" << percent(q.error) << "</td>"
+      << (seeds ? "<td class=\"n\">" + percent(q.loss) + "</td>" : "") << "<td>"
+      << (q.pareto ? "yes" : "") << "</td>";
     for (std::size_t k = 0; k < s.key_names.size(); ++k) {
       b << "<td class=\"n\">" << (q.values[k] ? num(*q.values[k], 4) : "&ndash;");
-      if (q.deviation[k] && q.run != s.points.front().run)
-        b << " (" << percent(*q.deviation[k]) << ")";
+      if (q.spread[k]) b << " &plusmn; " << num(*q.spread[k], 2);
+      if (q.deviation[k] && q.run != s.points.front().run) {
+        b << " (" << percent(*q.deviation[k]) << (q.within_scatter[k] ? ", inside the scatter" : "")
+          << ")";
+      }
       b << "</td>";
     }
     b << "</tr>\n";

@@ -11,15 +11,24 @@
 
 namespace rocklab::reports {
 
+// One setting of a study: its runs, one per seed.
 struct StudyPoint {
-  std::int64_t run = 0;
-  std::string setting;  // the varied keys' values, "numerics.timestep_safety = 0.3"
-  std::string status;
-  double wall_seconds = 0.0;
-  std::vector<std::optional<double>> values;     // per key result
-  std::vector<std::optional<double>> deviation;  // relative to the finest, per key result
-  double error = 0.0;   // the largest deviation; infinite when a run failed or missed a value
-  bool pareto = false;  // no faster run is as accurate
+  std::int64_t run = 0;            // its first run
+  std::vector<std::int64_t> runs;  // all of them, in order of seed
+  std::string setting;             // the varied keys' values, "numerics.timestep_safety = 0.3"
+  std::string status;              // completed, or the first status of a run that did not
+  double wall_seconds = 0.0;       // the mean over its runs
+  // Per key result: the mean over the runs, their standard deviation (with 2 seeds or more),
+  // and the mean's deviation from the finest setting's, relative.
+  std::vector<std::optional<double>> values, spread, deviation;
+  // Per key result: the deviation lies inside the seed scatter, Welch's 95% interval of the
+  // difference of the two means (lab/campaign/statistics.hpp); never with one seed.
+  std::vector<bool> within_scatter;
+  double error = 0.0;  // the largest deviation; infinite when a run failed or missed a value
+  // The largest deviation beyond the seed scatter: the accuracy the setting loses (with one
+  // seed, the error).
+  double loss = 0.0;
+  bool pareto = false;  // no faster setting loses as little
 };
 
 struct Study {
@@ -27,12 +36,14 @@ struct Study {
   std::vector<std::string> varied;                // the keys whose values differ between runs
   std::vector<std::string> key_names, key_units;  // the protocol's key results
   std::vector<StudyPoint> points;                 // points[0] is the finest: the reference
+  std::size_t seeds = 1;                          // runs per setting (its largest count)
   double tolerance = 0.05;                        // relative
-  int cheapest = 0;                               // index of the fastest point within the tolerance
+  int cheapest = 0;                               // the fastest point losing within the tolerance
 };
 
-// Reads the runs from the notebook (the first is the reference) and compares them. The runs
-// must be of one protocol. A deviation is relative to the reference's value, or absolute
+// Reads the runs from the notebook and compares them. The runs must be of one protocol; runs
+// that differ only in their seed are one setting, its key results their means; the first
+// setting is the reference. A deviation is relative to the reference's value, or absolute
 // where the reference is zero.
 Study evaluateStudy(const std::string& lab, const std::vector<std::int64_t>& runs,
                     double tolerance);

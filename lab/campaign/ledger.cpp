@@ -1,9 +1,12 @@
 #include "lab/campaign/ledger.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 
 #include "lab/campaign/statistics.hpp"
+#include "reports/key_results.hpp"
+#include "reports/run_data.hpp"
 #include "rigs/registry.hpp"
 
 namespace rocklab::campaign {
@@ -70,26 +73,46 @@ void recordTask(notebook::Notebook& lab, std::int64_t campaign, const Campaign& 
   s.run();
 }
 
+namespace {
+
+// A completed run's numbers: every recorded result, and each key result of its protocol that
+// a rule evaluates from its series (reports/key_results.hpp) rather than records.
+void addRunValues(notebook::Notebook& lab, std::int64_t run,
+                  std::map<std::string, std::pair<std::string, std::vector<double>>>& by_name) {
+  const reports::RunData r = reports::loadRun(lab, run);
+  for (const auto& [name, q] : r.results) {
+    if (!std::isfinite(q.value)) continue;
+    auto& [unit, values] = by_name[name];
+    unit = q.unit;
+    values.push_back(q.value);
+  }
+  for (const reports::KeyValue& k : reports::keyResults(r)) {
+    if (!k.value || r.results.count(k.name)) continue;
+    auto& [unit, values] = by_name[k.name];
+    unit = k.unit;
+    values.push_back(*k.value);
+  }
+}
+
+}  // namespace
+
 void updateStatistics(notebook::Notebook& lab, std::int64_t campaign, const Campaign& c) {
   auto& db = lab.db();
   notebook::Transaction tx(db);
   db.prepare("DELETE FROM campaign_statistics WHERE campaign_id = ?").bind(1, campaign).run();
-  auto results = db.prepare(
-      "SELECT r.name, r.unit, r.value FROM campaign_points p JOIN runs u ON u.id = p.run_id "
-      "JOIN results r ON r.run_id = p.run_id WHERE p.campaign_id = ? AND p.point = ? AND "
-      "u.status = 'completed' AND r.value IS NOT NULL ORDER BY r.name, p.seed");
+  auto runs = db.prepare(
+      "SELECT p.run_id FROM campaign_points p JOIN runs u ON u.id = p.run_id WHERE "
+      "p.campaign_id = ? AND p.point = ? AND u.status = 'completed' ORDER BY p.seed");
   auto insert = db.prepare(
       "INSERT INTO campaign_statistics (campaign_id, point, settings, name, unit, n, mean, std, "
       "ci95_low, ci95_high) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   for (const Point& p : c.points) {
+    std::vector<std::int64_t> ids;
+    runs.bind(1, campaign).bind(2, p.index);
+    while (runs.step()) ids.push_back(runs.integer(0));
+    runs.reset();
     std::map<std::string, std::pair<std::string, std::vector<double>>> by_name;
-    results.bind(1, campaign).bind(2, p.index);
-    while (results.step()) {
-      auto& [unit, values] = by_name[results.text(0)];
-      unit = results.text(1);
-      values.push_back(results.real(2));
-    }
-    results.reset();
+    for (std::int64_t id : ids) addRunValues(lab, id, by_name);
     for (const auto& [name, entry] : by_name) {
       const Summary m = summarize(entry.second);
       insert.bind(1, campaign).bind(2, p.index).bind(3, p.label()).bind(4, name);

@@ -1,5 +1,6 @@
 #include "lab/campaign/statistics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -51,9 +52,9 @@ double studentCdf(double t, double df) {
 
 }  // namespace
 
-double studentT975(std::size_t df) {
-  if (df == 0) throw std::invalid_argument("Student's t needs at least one degree of freedom");
-  const double nu = static_cast<double>(df);
+double studentT975(double df) {
+  if (!(df >= 1.0)) throw std::invalid_argument("Student's t needs at least one degree of freedom");
+  const double nu = df;
   // Bisection on the CDF: it rises monotonically; t(0.975) lies in [1.9, 12.8] for df >= 1.
   double lo = 1.9, hi = 12.8;
   for (int k = 0; k < 200 && hi - lo > 1e-13; ++k) {
@@ -79,10 +80,26 @@ Summary summarize(const std::vector<double>& values) {
   double ss = 0.0;
   for (double v : values) ss += (v - s.mean) * (v - s.mean);
   s.std = std::sqrt(ss / static_cast<double>(s.n - 1));
-  const double half = studentT975(s.n - 1) * s.std / std::sqrt(static_cast<double>(s.n));
+  const double half =
+      studentT975(static_cast<double>(s.n - 1)) * s.std / std::sqrt(static_cast<double>(s.n));
   s.low = s.mean - half;
   s.high = s.mean + half;
   return s;
+}
+
+Difference compareMeans(const Summary& a, const Summary& b) {
+  Difference d;
+  d.delta = b.mean - a.mean;
+  if (a.n < 2 || b.n < 2) return d;
+  d.known = true;
+  const double va = a.std * a.std / static_cast<double>(a.n);
+  const double vb = b.std * b.std / static_cast<double>(b.n);
+  if (va + vb == 0.0) return d;  // no scatter at all: any difference is resolved
+  const double df =
+      (va + vb) * (va + vb) /
+      (va * va / static_cast<double>(a.n - 1) + vb * vb / static_cast<double>(b.n - 1));
+  d.half = studentT975(std::max(df, 1.0)) * std::sqrt(va + vb);
+  return d;
 }
 
 }  // namespace rocklab::campaign

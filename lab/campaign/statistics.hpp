@@ -1,14 +1,15 @@
 #pragma once
 // An ensemble's statistics: what a key result is over the seeds of one campaign point.
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
 namespace rocklab::campaign {
 
-// The 97.5% quantile of Student's t distribution with `df` degrees of freedom (df >= 1): the
-// half-width factor of a two-sided 95% confidence interval.
-double studentT975(std::size_t df);
+// The 97.5% quantile of Student's t distribution with `df` degrees of freedom (df >= 1, not
+// necessarily whole: Welch's are not): the half-width factor of a two-sided 95% interval.
+double studentT975(double df);
 
 struct Summary {
   std::size_t n = 0;
@@ -19,5 +20,17 @@ struct Summary {
 };
 
 Summary summarize(const std::vector<double>& values);
+
+// Two ensembles' means compared: b.mean - a.mean with the half-width of Welch's 95% interval
+// of that difference (B. L. Welch, Biometrika 34, 1947: t at the Welch-Satterthwaite degrees
+// of freedom). A difference inside its interval is not resolved by the seeds: the two could
+// be one material. Needs two values in each (`known` false otherwise).
+struct Difference {
+  double delta = 0.0, half = 0.0;
+  bool known = false;
+  bool resolved() const { return known && std::abs(delta) > half; }
+};
+
+Difference compareMeans(const Summary& a, const Summary& b);
 
 }  // namespace rocklab::campaign

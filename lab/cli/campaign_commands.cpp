@@ -22,6 +22,7 @@
 #include "lab/campaign/ledger.hpp"
 #include "lab/cli/lab_commands.hpp"
 #include "lab/notebook/merge.hpp"
+#include "reports/campaign_report.hpp"
 #include "rigs/registry.hpp"
 
 namespace rocklab::cli {
@@ -364,7 +365,10 @@ int runSlurm(const CampaignOptions& o, const Opened& x) {
                             " --task \"$SLURM_ARRAY_TASK_ID\" --shard-dir " + shellQuoted(dir) +
                             " --scratch \"${TMPDIR:-/tmp}\" --quiet");
   std::string array;
-  for (const auto& t : queue) array += (array.empty() ? "" : ",") + std::to_string(t.task.index);
+  for (const auto& t : queue) {
+    if (!array.empty()) array += ',';
+    array += std::to_string(t.task.index);
+  }
   const campaign::SlurmOptions& s = c.slurm;
   std::string sbatch =
       "sbatch --parsable --job-name=" + shellQuoted("rocklab-" + c.name) + " --array=" + array +
@@ -373,7 +377,7 @@ int runSlurm(const CampaignOptions& o, const Opened& x) {
   if (!s.partition.empty()) sbatch += " --partition=" + shellQuoted(s.partition);
   if (!s.time.empty()) sbatch += " --time=" + shellQuoted(s.time);
   if (!s.account.empty()) sbatch += " --account=" + shellQuoted(s.account);
-  for (const auto& opt : s.options) sbatch += " " + shellQuoted(opt);
+  for (const auto& opt : s.options) sbatch.append(" ").append(shellQuoted(opt));
   const std::string job = capture(sbatch + " " + shellQuoted(task));
   const std::string job_id = job.substr(0, job.find(';'));
   std::cerr << "campaign " << c.name << ": " << queue.size() << " of " << states.size()
@@ -564,6 +568,20 @@ int campaignShow(const CampaignOptions& o) {
   }
   listFailed(c, states);
   return 0;
+}
+
+int campaignReport(const CampaignOptions& o) {
+  const auto x = openCampaign(o);
+  if (!x) return 2;
+  try {
+    const auto s = reports::writeCampaignReport({o.lab, x->c.name, o.out, o.data_dir});
+    std::cout << "wrote " << o.out << "/index.html (" << s.files.size() << " files, "
+              << static_cast<int>(s.seconds + 0.5) << " s)\n";
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "campaign " << x->c.name << ": " << e.what() << "\n";
+    return 1;
+  }
 }
 
 int notebookMerge(const std::string& into, const std::vector<std::string>& sources) {

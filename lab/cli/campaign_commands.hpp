@@ -19,6 +19,8 @@ struct CampaignOptions {
   int task = -1;                    // `campaign task`: which one
   std::string shard_dir;            // `campaign task`: where its shard goes
   std::string scratch;              // `campaign task`: local storage to run in, if any
+  std::string out;                  // `campaign report`: its folder
+  std::string data_dir;             // `campaign report`: the folder holding paper.toml
 };
 
 int campaignCheck(const CampaignOptions& o);
@@ -29,6 +31,8 @@ int campaignTask(const CampaignOptions& o);
 // Merges the campaign's shards into the lab and updates its statistics.
 int campaignCollect(const CampaignOptions& o);
 int campaignShow(const CampaignOptions& o);
+// The campaign's report (reports/campaign_report.hpp) from the lab.
+int campaignReport(const CampaignOptions& o);
 // Merges the runs of each `sources` notebook into `into` (twice is the same as once).
 int notebookMerge(const std::string& into, const std::vector<std::string>& sources);
 

@@ -383,6 +383,10 @@ void addStudy(CLI::App& app, Action& action) {
   acc->add_option("--tolerance", o->tolerance_percent,
                   "Largest deviation of a key result accepted (%), to name the cheapest setting")
       ->check(CLI::Range(1e-6, 1e6));
+  acc->add_option("--seeds", o->seeds,
+                  "Runs per setting at successive seeds: a deviation inside their scatter is "
+                  "not a loss of accuracy")
+      ->check(CLI::Range(1, 1000));
   acc->add_option("--threads", o->threads, "Threads of every run (same results)")
       ->check(CLI::Range(1, 1024));
   acc->add_flag("--quiet", o->quiet, "No progress line on stderr");
@@ -391,7 +395,9 @@ void addStudy(CLI::App& app, Action& action) {
 
   auto runs = std::make_shared<std::vector<std::int64_t>>();
   auto* sr = st->add_subcommand(
-      "report", "Write the report of a study from its runs in the notebook, the finest first");
+      "report",
+      "Write the report of a study from its runs in the notebook, the finest first (runs that "
+      "differ only in their seed are one setting)");
   sr->add_option("runs", *runs, "Run ids of one protocol, the finest setting first")->required();
   sr->add_option("--lab", o->lab, "Lab notebook (SQLite)");
   sr->add_option("--out", o->out, "Output folder of the study report")->required();
@@ -538,6 +544,16 @@ void addCampaign(CLI::App& app, Action& action) {
   file(show);
   show->add_option("--lab", o->lab, "Lab notebook (SQLite)");
   show->callback([&action, o] { action = [o] { return rocklab::cli::campaignShow(*o); }; });
+  o->data_dir = ROCKLAB_DATA_DIR;
+  auto* report = c->add_subcommand(
+      "report",
+      "Write the campaign's report: each point's key results over its seeds and each rig's "
+      "figures with their spread (mean and a band of one standard deviation)");
+  file(report);
+  report->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+  report->add_option("--out", o->out, "Output folder")->required();
+  report->add_option("--data", o->data_dir, "Folder holding paper.toml");
+  report->callback([&action, o] { action = [o] { return rocklab::cli::campaignReport(*o); }; });
 }
 
 }  // namespace

@@ -156,16 +156,29 @@ int studyAccuracy(const StudyOptions& o) {
         }
       }
     }
-    // Every setting is checked before the first run: a bad value writes nothing.
-    for (const auto& combo : combinations(ladders)) {
-      protocol::Settings s = c.settings;
-      for (const auto& [key, value] : combo) {
-        s.apply({{key, value, "--vary"}});
+    if (o.seeds < 1) throw protocol::ProtocolError({"study: --seeds must be at least 1"});
+    for (const Ladder& l : ladders) {
+      if (l.key == "protocol.seed" && o.seeds > 1) {
+        throw protocol::ProtocolError(
+            {"--vary protocol.seed with --seeds: the seeds of each setting are --seeds'"});
       }
-      if (o.threads > 0) s.runChoice("numerics.threads", static_cast<std::int64_t>(o.threads));
-      rigs::validateProtocol(*c.rig, s);
-      runs.push_back(std::move(s));
-      labels.push_back(describe(combo));
+    }
+    // Every setting is checked before the first run: a bad value writes nothing. Each runs
+    // at the protocol's seed and the seeds - 1 after it.
+    const std::int64_t seed0 = c.settings.integer("protocol.seed");
+    for (const auto& combo : combinations(ladders)) {
+      for (int k = 0; k < o.seeds; ++k) {
+        protocol::Settings s = c.settings;
+        for (const auto& [key, value] : combo) {
+          s.apply({{key, value, "--vary"}});
+        }
+        if (o.seeds > 1) s.override("protocol.seed", seed0 + k);
+        if (o.threads > 0) s.runChoice("numerics.threads", static_cast<std::int64_t>(o.threads));
+        rigs::validateProtocol(*c.rig, s);
+        runs.push_back(std::move(s));
+        labels.push_back(describe(combo) +
+                         (o.seeds > 1 ? ", seed " + std::to_string(seed0 + k) : ""));
+      }
     }
   } catch (const protocol::ProtocolError& e) {
     std::cerr << e.what() << "\n";

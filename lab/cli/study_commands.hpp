@@ -16,6 +16,7 @@ struct StudyOptions {
   std::string lab = "lab.sqlite";
   std::string out;
   double tolerance_percent = 5.0;
+  int seeds = 1;    // runs per setting: the protocol's seed and the ones after it
   int threads = 0;  // 0: as the protocol says
   bool quiet = false;
   bool dry_run = false;  // check every setting and list them, run nothing

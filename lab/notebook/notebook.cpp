@@ -421,7 +421,8 @@ std::string RunWriter::mark() {
                               " WHERE run_id = ?");
     s.bind(1, id_);
     s.step();
-    m += (m.empty() ? "" : " ") + std::string(table) + ":" + std::to_string(s.integer(0));
+    if (!m.empty()) m += ' ';
+    m.append(table).append(":").append(std::to_string(s.integer(0)));
   }
   return m;
 }

@@ -3,6 +3,7 @@
 #include <bit>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <optional>
 #include <sstream>
@@ -136,7 +137,10 @@ Cell Statement::cell(int c) const {
       break;
     case SQLITE_BLOB:  // samples: shown by size, read with doubles()
       x.type = Cell::Type::Text;
-      x.text = "<" + std::to_string(sqlite3_column_bytes(stmt_, c)) + " bytes>";
+      // snprintf, not string concatenation: GCC 12 warns falsely (-Wrestrict) on the latter.
+      char size[32];
+      std::snprintf(size, sizeof size, "<%d bytes>", sqlite3_column_bytes(stmt_, c));
+      x.text = size;
       break;
     default:
       x.type = Cell::Type::Text;

@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <sstream>
 
+#include "lab/campaign/statistics.hpp"
 #include "reports/figures/figures.hpp"
 
 namespace rocklab::reports {
@@ -82,6 +84,16 @@ Figure stressStrain(const std::vector<Test>& tests, const Paper& paper, const st
   return f;
 }
 
+// The Mohr-Coulomb line of a fit in the (p, q) plane at the confinements s3 (Li & Holt,
+// equation 1: sigma_1 = N sigma_3 + UCS, N = tan^2(45 + phi/2)): q at each s3.
+std::vector<double> mohrCoulombQ(double phi_deg, double ucs, const std::vector<double>& s3) {
+  const double s = std::sin(phi_deg * std::numbers::pi / 180.0);
+  const double N = (1.0 + s) / (1.0 - s);
+  std::vector<double> q;
+  for (double x : s3) q.push_back((N - 1.0) * x + ucs);
+  return q;
+}
+
 // Figure 6: the critical points in the (p, q) plane, p = mean stress; the Mohr-Coulomb
 // line sigma_1 = N sigma_3 + UCS of the run's fit drawn through the same plane, and the
 // cap joining the compactive points (from the last dilatant one).
@@ -125,17 +137,16 @@ Figure failureEnvelope(const RunData& r, const std::vector<Test>& tests) {
   const Quantity* phi = r.result("friction_angle_deg");
   const Quantity* ucs = r.result("mohr_coulomb_ucs_MPa");
   if (phi && ucs) {
-    const double s = std::sin(phi->value * std::numbers::pi / 180.0);
-    const double N = (1.0 + s) / (1.0 - s);  // tan^2(45 + phi/2)
     std::ostringstream label;
     label.precision(3);
     label << "Mohr-Coulomb: phi = " << phi->value << " deg, UCS = " << ucs->value << " MPa";
     Series line{label.str(), {}, {}, false};
-    for (int k = 0; k <= 20; ++k) {
-      const double s3 = sigma3_max * 1.1 * k / 20.0;
-      const double q = (N - 1.0) * s3 + ucs->value;
-      line.x.push_back(s3 + q / dim);
-      line.y.push_back(q);
+    std::vector<double> s3;
+    for (int k = 0; k <= 20; ++k) s3.push_back(sigma3_max * 1.1 * k / 20.0);
+    const std::vector<double> q = mohrCoulombQ(phi->value, ucs->value, s3);
+    for (std::size_t k = 0; k < s3.size(); ++k) {
+      line.x.push_back(s3[k] + q[k] / dim);
+      line.y.push_back(q[k]);
     }
     pq.series.push_back(line);
   }
@@ -164,7 +175,106 @@ std::vector<Figure> loadingFigures(const std::vector<const RunData*>& runs, cons
   return out;
 }
 
+// A point of Figure 6 over seeds: test K's critical point in every run.
+struct CriticalPoints {
+  std::vector<double> p, q;
+  int compactive = 0;
+};
+
+std::string withInterval(const campaign::Summary& m, const char* unit) {
+  std::ostringstream o;
+  o.precision(3);
+  o << m.mean;
+  if (m.n > 1) o << " [" << m.low << ", " << m.high << "]";
+  o << " " << unit;
+  return o.str();
+}
+
 }  // namespace
+
+// Figure 6 over an ensemble: each test's critical point averaged over the seeds with a bar
+// of one standard deviation in q, classed compactive where most seeds found it so; the
+// Mohr-Coulomb line of each seed's fit averaged with its band, and the fit's friction angle
+// and UCS as means with their 95% intervals.
+std::vector<Figure> envelopeEnsembleFigures(const std::vector<const RunData*>& seeds,
+                                            const Paper&) {
+  if (seeds.empty()) return {};
+  std::map<std::string, CriticalPoints> by_test;
+  std::vector<std::string> order;
+  std::vector<double> phis, ucss;
+  double sigma3_max = 0.0;
+  for (const RunData* r : seeds) {
+    for (const Test& t : testsOf(*r)) {
+      sigma3_max = std::max(sigma3_max, t.sigma3);
+      const Quantity* q = r->result(t.prefix + "critical_deviatoric_stress_MPa");
+      const Quantity* p = r->result(t.prefix + "critical_mean_stress_MPa");
+      const Quantity* c = r->result(t.prefix + "critical_is_compaction");
+      if (!q || !p || !c) continue;
+      if (!by_test.count(t.prefix)) order.push_back(t.prefix);
+      CriticalPoints& points = by_test[t.prefix];
+      points.p.push_back(p->value);
+      points.q.push_back(q->value);
+      points.compactive += c->value > 0.5;
+    }
+    const Quantity* phi = r->result("friction_angle_deg");
+    const Quantity* ucs = r->result("mohr_coulomb_ucs_MPa");
+    if (phi && ucs) phis.push_back(phi->value), ucss.push_back(ucs->value);
+  }
+  if (order.empty()) return {};
+  const RunData& first = *seeds.front();
+  const int dim = first.param("protocol.dimension") == "2" ? 2 : 3;
+  Figure f;
+  f.id = "failure-envelope";
+  f.title = "Failure envelope over " + std::to_string(seeds.size()) + " seeds, " + first.protocol;
+  f.caption =
+      "Critical points of each test in the mean stress - deviatoric stress plane (Li & Holt, "
+      "Figure 6), each the mean over the seeds with a bar of one standard deviation in q; a "
+      "test's point is compactive (the onset of shear-enhanced compaction) where most seeds "
+      "found it so, dilatant (the peak) otherwise. The line is the mean of the seeds' "
+      "Mohr-Coulomb fits of their dilatant points, its band one standard deviation; its "
+      "legend gives the fits' friction angle and UCS as means with their 95% confidence "
+      "intervals (Student t).";
+  Series dilatant{"dilatant critical points (peak)", {}, {}, true};
+  Series compactive{"compactive critical points (onset of compaction)", {}, {}, true};
+  for (const std::string& prefix : order) {
+    const CriticalPoints& c = by_test[prefix];
+    const campaign::Summary p = campaign::summarize(c.p), q = campaign::summarize(c.q);
+    Series& s = 2 * c.compactive > static_cast<int>(c.p.size()) ? compactive : dilatant;
+    s.x.push_back(p.mean);
+    s.y.push_back(q.mean);
+    s.low.push_back(q.mean - q.std);
+    s.high.push_back(q.mean + q.std);
+  }
+  Panel pq{"mean stress p (MPa)", "deviatoric stress q (MPa)", {}};
+  if (!phis.empty()) {
+    std::vector<double> s3;
+    for (int k = 0; k <= 20; ++k) s3.push_back(sigma3_max * 1.1 * k / 20.0);
+    std::vector<std::vector<double>> lines;
+    for (std::size_t k = 0; k < phis.size(); ++k)
+      lines.push_back(mohrCoulombQ(phis[k], ucss[k], s3));
+    Series line{"Mohr-Coulomb, " + std::to_string(phis.size()) +
+                    " fits: phi = " + withInterval(campaign::summarize(phis), "deg") +
+                    ", UCS = " + withInterval(campaign::summarize(ucss), "MPa"),
+                {},
+                {},
+                false};
+    for (std::size_t i = 0; i < s3.size(); ++i) {
+      std::vector<double> at;
+      for (const auto& l : lines) at.push_back(l[i]);
+      const campaign::Summary q = campaign::summarize(at);
+      line.x.push_back(s3[i] + q.mean / dim);
+      line.y.push_back(q.mean);
+      line.low.push_back(q.mean - q.std);
+      line.high.push_back(q.mean + q.std);
+    }
+    pq.series.push_back(line);
+  }
+  for (Series* s : {&dilatant, &compactive}) {
+    if (!s->x.empty()) pq.series.push_back(*s);
+  }
+  f.panels = {pq};
+  return {f};
+}
 
 std::vector<Figure> biaxialFigures(const std::vector<const RunData*>& runs, const Paper& paper) {
   return loadingFigures(runs, paper, "biaxial-stress-strain");

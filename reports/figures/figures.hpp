@@ -17,7 +17,11 @@ using FigureBuilder = std::vector<Figure> (*)(const std::vector<const RunData*>&
 
 struct FigureEntry {
   std::string_view rig;
-  FigureBuilder build;
+  FigureBuilder build;  // the runs overlaid
+  // For the runs of one protocol at several seeds (a campaign point): the figures that a
+  // mean of each run's would misstate, which replace those of the same id (reports/ensemble.hpp
+  // combines the others). May be null.
+  FigureBuilder ensemble = nullptr;
 };
 
 const std::vector<FigureEntry>& figureTable();
@@ -26,6 +30,8 @@ std::vector<Figure> oedometerFigures(const std::vector<const RunData*>& runs, co
 std::vector<Figure> hydrostaticFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> biaxialFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> envelopeFigures(const std::vector<const RunData*>& runs, const Paper& paper);
+std::vector<Figure> envelopeEnsembleFigures(const std::vector<const RunData*>& seeds,
+                                            const Paper& paper);
 std::vector<Figure> permeameterFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> ultrasonicFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 

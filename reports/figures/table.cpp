@@ -5,7 +5,7 @@ namespace rocklab::reports {
 const std::vector<FigureEntry>& figureTable() {
   static const std::vector<FigureEntry> table = {
       {"oedometer", oedometerFigures},     {"hydrostatic", hydrostaticFigures},
-      {"biaxial", biaxialFigures},         {"envelope", envelopeFigures},
+      {"biaxial", biaxialFigures},         {"envelope", envelopeFigures, envelopeEnsembleFigures},
       {"permeameter", permeameterFigures}, {"ultrasonic", ultrasonicFigures},
   };
   return table;

@@ -64,6 +64,44 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
   EXPECT_NE(out.find("point 1 (material.friction=0.5): 2/2 runs completed"), std::string::npos)
       << out;
   EXPECT_NE(out.find("mean_stress_peak_MPa"), std::string::npos) << out;
+  // A key result a rule evaluates from the runs' series has its statistics too.
+  EXPECT_EQ(rows(lab.path,
+                 "SELECT count(*) FROM campaign_statistics WHERE n = 2 AND name = "
+                 "'broken_bond_fraction_at_peak'"),
+            std::vector<std::string>{"2|"});
+  // The report: the key results per point, and each figure over the seeds with its spread.
+  const std::string report = lab.path + ".report";
+  ASSERT_EQ(runRocklab("campaign report " + file + " --lab " + lab.path + " --out " + report, &out),
+            0)
+      << out;
+  std::ifstream page_in(report + "/index.html");
+  const std::string page(std::istreambuf_iterator<char>(page_in), {});
+  EXPECT_NE(page.find("Point 1: <code>material.friction=0.5</code>, 2 completed runs"),
+            std::string::npos);
+  EXPECT_NE(page.find("Over 2 seeds (runs "), std::string::npos);
+  std::ifstream csv_in(report + "/key-results.csv");
+  const std::string csv(std::istreambuf_iterator<char>(csv_in), {});
+  EXPECT_NE(csv.find("\n1,material.friction=0.5,broken_bond_fraction_at_peak,-,2,"),
+            std::string::npos)
+      << csv;
+  std::size_t figures = 0, banded = 0;
+  for (const auto& e : fs::directory_iterator(report)) {
+    if (e.path().extension() != ".csv" || e.path().filename() == "key-results.csv") continue;
+    ++figures;
+    std::ifstream in(e.path());
+    std::string header, row;
+    std::getline(in, header);
+    // A curve's row with its band: panel,series,x,y,low,high all given.
+    while (std::getline(in, row)) {
+      if (std::regex_match(row, std::regex("[0-9]+,[^,]*,[^,]+,[^,]+,[^,]+,[^,]+"))) {
+        ++banded;
+        break;
+      }
+    }
+  }
+  EXPECT_GE(figures, 2u);
+  EXPECT_GE(banded, 2u);
+  fs::remove_all(report);
   // The shards are merged and gone.
   EXPECT_FALSE(fs::exists(lab.path + ".campaigns/friction/task-0.sqlite"));
   // Run again: nothing to do.

@@ -344,7 +344,8 @@ TEST(Protocols, InvalidProtocolWritesNothing) {
 }
 
 // A study end to end on the cheapest quick protocol: two settings of the re-triangulation
-// threshold, each a run in the notebook with its value, compared on the key results.
+// threshold at two seeds each, every run in the notebook with its value and seed, compared
+// on the key results' means against the seed scatter.
 TEST(Protocols, AccuracyStudyRunsTheLadderAndReportsIt) {
   Lab lab("study");
   const std::string out_dir = lab.path + ".study";
@@ -352,22 +353,27 @@ TEST(Protocols, AccuracyStudyRunsTheLadderAndReportsIt) {
   ASSERT_EQ(rocklab::testing::runRocklab(
                 "study accuracy " + sourceDir() +
                     "/protocols/permeameter-hydrostatic-3d-quick.toml --quiet --threads 1"
-                    " --vary flow.retriangulate_displacement_radii=0.25,2 --tolerance 50 --lab " +
+                    " --vary flow.retriangulate_displacement_radii=0.25,2 --seeds 2"
+                    " --tolerance 50 --lab " +
                     lab.path + " --out " + out_dir,
                 &out),
             0)
       << out;
   EXPECT_NE(out.find("cheapest within 50%: run "), std::string::npos) << out;
+  EXPECT_NE(out.find("beyond the scatter of 2 seeds"), std::string::npos) << out;
   nb::Notebook n(lab.path);
   EXPECT_EQ(scalar(n,
-                   "SELECT group_concat(value, ' ') FROM (SELECT value FROM params WHERE key = "
-                   "'flow.retriangulate_displacement_radii' ORDER BY run_id)"),
-            "0.25 2");
-  EXPECT_EQ(scalar(n, "SELECT count(*) FROM runs WHERE status = 'completed'"), "2");
+                   "SELECT group_concat(a.value || '@' || b.value, ' ') FROM (SELECT run_id, value "
+                   "FROM params WHERE key = 'flow.retriangulate_displacement_radii') a JOIN "
+                   "(SELECT run_id, value FROM params WHERE key = 'protocol.seed') b USING "
+                   "(run_id) ORDER BY run_id"),
+            "0.25@12 0.25@13 2@12 2@13");
+  EXPECT_EQ(scalar(n, "SELECT count(*) FROM runs WHERE status = 'completed'"), "4");
   std::ifstream page(out_dir + "/index.html");
   const std::string html((std::istreambuf_iterator<char>(page)), {});
   EXPECT_NE(html.find("flow.retriangulate_displacement_radii = 2"), std::string::npos);
   EXPECT_NE(html.find("k_over_k0_final"), std::string::npos);
+  EXPECT_NE(html.find("Each setting ran at 2 seeds"), std::string::npos);
   EXPECT_GT(std::filesystem::file_size(out_dir + "/cost-accuracy.png"), 5000u);
   std::filesystem::remove_all(out_dir);
   std::filesystem::remove_all(lab.path + ".files");

@@ -147,6 +147,28 @@ TEST(CampaignStatistics, StudentQuantilesMatchTheTables) {
   for (const auto& [df, t] : table) EXPECT_NEAR(studentT975(df), t, 5e-5) << "df " << df;
   EXPECT_NEAR(studentT975(100000), 1.95996, 1e-4);  // the normal quantile
   EXPECT_THROW(studentT975(0), std::invalid_argument);
+  // Between the whole degrees of freedom (Welch's are not whole), the quantile falls
+  // monotonically: t(2.5) lies between t(2) and t(3).
+  EXPECT_LT(studentT975(2.5), 4.3027);
+  EXPECT_GT(studentT975(2.5), 3.1824);
+}
+
+// Welch's interval in the two cases with a closed form: equal sizes and scatters give
+// 2(n - 1) degrees of freedom and a half-width t sqrt(2 s^2 / n); one ensemble without
+// scatter leaves the other's own 95% interval.
+TEST(CampaignStatistics, WelchIntervalOfADifferenceOfMeans) {
+  const Summary a = summarize({1.0, 2.0, 3.0}), b = summarize({2.0, 3.0, 4.0});
+  const Difference d = compareMeans(a, b);
+  EXPECT_TRUE(d.known);
+  EXPECT_DOUBLE_EQ(d.delta, 1.0);
+  EXPECT_NEAR(d.half, 2.7764 * std::sqrt(2.0 / 3.0), 1e-4);
+  EXPECT_FALSE(d.resolved());  // one apart, 2.27 the interval's half: the seeds do not tell
+  EXPECT_TRUE(compareMeans(a, summarize({11.0, 12.0, 13.0})).resolved());
+  const Summary flat = summarize({5.0, 5.0, 5.0, 5.0}), c = summarize({4.0, 6.0, 7.0});
+  const Difference e = compareMeans(flat, c);
+  EXPECT_NEAR(e.half, c.high - c.mean, 1e-9);
+  EXPECT_FALSE(compareMeans(summarize({1.0}), b).known);
+  EXPECT_FALSE(compareMeans(summarize({1.0}), b).resolved());
 }
 
 TEST(CampaignStatistics, SummaryOfAnEnsemble) {

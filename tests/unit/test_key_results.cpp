@@ -195,12 +195,71 @@ TEST(AccuracyStudy, ErrorParetoFrontAndCheapestWithinTolerance) {
   EXPECT_NE(page.find("2.5&times; faster"), std::string::npos);
   EXPECT_NE(page.find("cost-accuracy.png"), std::string::npos);
   const std::string chart = slurp(out + "/cost-accuracy.csv");
-  EXPECT_NE(chart.find("1,Pareto front,20,8\n1,Pareto front,40,2\n1,Pareto front,100,0\n"),
+  EXPECT_NE(chart.find("1,Pareto front,20,8,,\n1,Pareto front,40,2,,\n1,Pareto front,100,0,,\n"),
             std::string::npos)
       << chart;
   EXPECT_GT(std::filesystem::file_size(out + "/cost-accuracy.png"), 5000u);
   const std::string table = slurp(out + "/study.csv");
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 6);  // header and five runs
+  std::filesystem::remove_all(out);
+  for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(lab + ext);
+}
+
+// A study over seeds: runs that differ only in their seed are one setting, compared by their
+// means. A deviation the seeds cannot resolve is no loss of accuracy, one beyond the scatter
+// is: with a 1% tolerance the cheapest is the setting 2.5% off inside the scatter.
+TEST(AccuracyStudy, ADeviationInsideTheSeedScatterIsNoLoss) {
+  const std::string lab = (std::filesystem::temp_directory_path() /
+                           ("rocklab-study-seeds-" + std::to_string(::getpid()) + ".sqlite"))
+                              .string();
+  std::filesystem::remove(lab);
+  struct Row {
+    double safety, seconds;
+    std::vector<double> peaks;  // at seeds 1, 2, 3
+  };
+  // Means 25, 25.63 (2.5% off, Welch half-width about 2.5 MPa) and 30 (20% off, resolved).
+  const std::vector<Row> rows = {
+      {0.2, 100, {25.0, 26.0, 24.0}}, {0.4, 40, {25.6, 26.4, 24.9}}, {0.8, 10, {30.0, 31.0, 29.0}}};
+  std::vector<std::int64_t> ids;
+  {
+    notebook::Notebook nb(lab);
+    for (const Row& row : rows) {
+      for (std::size_t k = 0; k < row.peaks.size(); ++k) {
+        notebook::RunInfo info;
+        info.protocol = "biaxial-ucs-quick";
+        info.rig = "biaxial";
+        notebook::RunWriter w(nb, info,
+                              {{"numerics.timestep_safety", std::to_string(row.safety), "-"},
+                               {"protocol.seed", std::to_string(k + 1), "-"},
+                               {"protocol.key_results", "[\"peak_deviatoric_stress_MPa\"]", ""}});
+        w.result("peak_deviatoric_stress_MPa", row.peaks[k], "MPa");
+        w.finish(notebook::RunStatus::Completed);
+        ids.push_back(w.id());
+        nb.db().exec("UPDATE runs SET wall_seconds = " + std::to_string(row.seconds + k) +
+                     " WHERE id = " + std::to_string(w.id()));
+      }
+    }
+  }
+  const Study s = evaluateStudy(lab, ids, 0.01);
+  EXPECT_EQ(s.varied, std::vector<std::string>{"numerics.timestep_safety"});
+  EXPECT_EQ(s.seeds, 3u);
+  ASSERT_EQ(s.points.size(), 3u);
+  EXPECT_EQ(s.points[1].runs, (std::vector<std::int64_t>{ids[3], ids[4], ids[5]}));
+  EXPECT_NEAR(s.points[1].wall_seconds, 41.0, 1e-9);
+  EXPECT_NEAR(*s.points[1].values[0], 76.9 / 3.0, 1e-9);
+  EXPECT_NEAR(*s.points[1].spread[0], 1.0, 0.3);
+  EXPECT_NEAR(s.points[1].error, (76.9 / 3.0 - 25.0) / 25.0, 1e-9);
+  EXPECT_TRUE(s.points[1].within_scatter[0]);
+  EXPECT_DOUBLE_EQ(s.points[1].loss, 0.0);
+  EXPECT_FALSE(s.points[2].within_scatter[0]);
+  EXPECT_NEAR(s.points[2].loss, 0.2, 1e-9);
+  EXPECT_EQ(s.cheapest, 1);
+  const std::string out = lab + ".report";
+  writeStudyReport(s, out);
+  std::ifstream in(out + "/index.html");
+  const std::string page(std::istreambuf_iterator<char>(in), {});
+  EXPECT_NE(page.find("inside the scatter"), std::string::npos);
+  EXPECT_NE(page.find("is not a loss of accuracy"), std::string::npos);
   std::filesystem::remove_all(out);
   for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(lab + ext);
 }

@@ -17,6 +17,7 @@
 #include <set>
 
 #include "reports/chart.hpp"
+#include "reports/ensemble.hpp"
 #include "reports/snapshot.hpp"
 #include "reports/vtk_export.hpp"
 
@@ -100,10 +101,108 @@ TEST(Charts, CurvesAreDrawnAndTheCsvHoldsTheirPoints) {
   std::string line;
   int rows = 0;
   std::getline(csv, line);
-  EXPECT_EQ(line, "panel,series,x,y");
+  EXPECT_EQ(line, "panel,series,x,y,low,high");
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 3 * 101);
   fs::remove_all(dir);
+}
+
+// An ensemble's spread: a translucent band about a line in the line's colour, error bars
+// through points; the CSV holds both bounds.
+TEST(Charts, ASpreadIsABandAboutALineAndBarsThroughPoints) {
+  const std::string dir = tempDir("spread");
+  Series mean{"mean", {}, {}, false}, points{"points", {0.2, 0.5, 0.8}, {40, 50, 60}, true};
+  for (int i = 0; i <= 100; ++i) {
+    mean.x.push_back(i * 0.01);
+    mean.y.push_back(30 + 60 * i * 0.01);
+    mean.low.push_back(mean.y.back() - 8.0);
+    mean.high.push_back(mean.y.back() + 8.0);
+  }
+  points.low = {35, 45, 55};
+  points.high = {45, 55, 65};
+  Figure f{"spread", "spread", "", {Panel{"strain", "stress (MPa)", {points, mean}}}};
+  renderFigure(f, dir);
+  const Pixels p = readPng(dir + "/spread.png");
+  // The band: orange (230, 159, 0) at alpha 60/255 over white, about (249, 232, 195), a
+  // strip 16 MPa high (a fifth of the axis) along the whole width.
+  EXPECT_GT(p.count({249, 232, 195}, 8), 20000u);
+  std::ifstream csv(dir + "/spread.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::getline(csv, line);
+  EXPECT_EQ(line, "1,points,0.2,40,35,45");
+  std::getline(csv, line);
+  std::getline(csv, line);
+  std::getline(csv, line);
+  EXPECT_EQ(line, "1,mean,0,30,22,38");
+  fs::remove_all(dir);
+}
+
+// A run's mention leaves a text: "run 12" as a word, "-run12" in an id; other numbers stay.
+TEST(Ensembles, ARunsMentionIsDroppedFromItsFiguresTexts) {
+  EXPECT_EQ(withoutRun("run 12 biaxial-ucs-quick (virgin)", 12), "biaxial-ucs-quick (virgin)");
+  EXPECT_EQ(withoutRun("failure-envelope-run12", 12), "failure-envelope");
+  EXPECT_EQ(withoutRun("Failure envelope, run 12 triaxial", 12), "Failure envelope, triaxial");
+  EXPECT_EQ(withoutRun("run 123 and rerun 12", 12), "run 123 and rerun 12");
+  EXPECT_EQ(withoutRun("run 12", 12), "");
+}
+
+// Three seeds' figures of a loading and an unloading (y = a x, a = 1, 2, 3; unloading 0.1
+// above): the curve is their mean branch by branch with a band of one standard deviation;
+// points are averaged point by point; numbers that differ in labels become mean +- std; the
+// paper's point, the same in every run, stays as it is.
+TEST(Ensembles, CurvesAreAveragedBranchByBranchAndPointsPointByPoint) {
+  std::vector<RunFigures> runs;
+  for (int a = 1; a <= 3; ++a) {
+    Series curve{"run " + std::to_string(a) + " loading", {}, {}, false};
+    for (int i = 0; i <= 50; ++i) curve.x.push_back(i / 50.0), curve.y.push_back(a * i / 50.0);
+    for (int i = 1; i <= 25; ++i) {
+      const double x = 1.0 - i / 50.0;
+      curve.x.push_back(x), curve.y.push_back(a * x + 0.1);
+    }
+    Series fit{"Mohr-Coulomb: phi = " + std::to_string(29 + a) + " deg",
+               {1.0, 2.0},
+               {10.0 * a, 20.0 * a},
+               true};
+    Series paper{"paper: UCS", {0.0}, {12.0}, true};
+    Figure f{"stress-run" + std::to_string(a),
+             "Stress, run " + std::to_string(a) + " ucs",
+             "Caption.",
+             {Panel{"strain", "stress", {curve, fit, paper}}}};
+    runs.push_back({a, {f}});
+  }
+  const std::vector<Figure> out = combineFigures(runs);
+  ASSERT_EQ(out.size(), 1u);
+  const Figure& f = out.front();
+  EXPECT_EQ(f.id, "stress");
+  EXPECT_EQ(f.title, "Stress, ucs");
+  EXPECT_NE(f.caption.find("Over 3 seeds (runs 1, 2, 3)"), std::string::npos) << f.caption;
+  ASSERT_EQ(f.panels.at(0).series.size(), 3u);
+  const Series& c = f.panels[0].series[0];
+  EXPECT_EQ(c.label, "loading");
+  ASSERT_EQ(c.x.size(), 240u);  // two branches of 120 points
+  EXPECT_DOUBLE_EQ(c.x.front(), 0.0);
+  EXPECT_DOUBLE_EQ(c.x[119], 1.0);
+  EXPECT_DOUBLE_EQ(c.x[120], 1.0);
+  EXPECT_DOUBLE_EQ(c.x.back(), 0.5);
+  for (std::size_t k = 0; k < 120; ++k) {  // mean 2x, std x (of x, 2x, 3x)
+    EXPECT_NEAR(c.y[k], 2.0 * c.x[k], 1e-9);
+    EXPECT_NEAR(c.high[k] - c.y[k], c.x[k], 1e-9);
+  }
+  EXPECT_NEAR(c.y.back(), 2.0 * 0.5 + 0.1, 1e-9);
+  const Series& fit = f.panels[0].series[1];
+  EXPECT_EQ(fit.label, "Mohr-Coulomb: phi = 31 +- 1 deg");
+  EXPECT_EQ(fit.x, (std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(fit.y, (std::vector<double>{20.0, 40.0}));
+  EXPECT_NEAR(fit.high[1] - fit.y[1], 20.0, 1e-9);  // of 20, 40, 60
+  EXPECT_TRUE(f.panels[0].series[2].low.empty());   // the paper's: no spread
+
+  // A seed whose points differ in number: the figure is the first run's and says why.
+  runs[2].figures[0].panels[0].series[1].x.push_back(3.0);
+  runs[2].figures[0].panels[0].series[1].y.push_back(90.0);
+  const Figure one = combineFigures(runs).front();
+  EXPECT_NE(one.caption.find("One seed's (run 1)"), std::string::npos) << one.caption;
+  EXPECT_TRUE(one.panels[0].series[0].low.empty());
 }
 
 // A lattice of 7^3 spheres (an odd count: the mid-plane cuts a layer through its centres),

@@ -1,0 +1,214 @@
+#include "reports/campaign_report.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "lab/notebook/notebook.hpp"
+#include "reports/ensemble.hpp"
+#include "reports/figures/figures.hpp"
+#include "reports/html.hpp"
+#include "reports/key_results.hpp"
+#include "reports/paper.hpp"
+#include "reports/run_data.hpp"
+
+namespace rocklab::reports {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TaskRow {
+  int point = 0;
+  std::int64_t seed = 0, run = 0;
+  std::string settings, status, reason;
+};
+
+struct StatisticRow {
+  std::int64_t n = 0;
+  double mean = 0.0, std = 0.0;
+  std::optional<double> low, high;
+  std::string unit;
+};
+
+struct CampaignData {
+  std::int64_t id = 0;
+  std::string name, file, text, protocol;
+  std::vector<TaskRow> tasks;
+  std::map<int, std::string> points;  // point -> its settings
+  std::map<std::pair<int, std::string>, StatisticRow> statistics;
+};
+
+CampaignData loadCampaign(notebook::Notebook& nb, const std::string& name) {
+  CampaignData c;
+  auto& db = nb.db();
+  auto q = db.prepare("SELECT id, name, file, text, protocol FROM campaigns WHERE name = ?");
+  q.bind(1, name);
+  if (!q.step())
+    throw std::invalid_argument("campaign '" + name + "' has not run in this notebook");
+  c.id = q.integer(0), c.name = q.text(1), c.file = q.text(2), c.text = q.text(3);
+  c.protocol = q.text(4);
+  auto t = db.prepare(
+      "SELECT p.point, p.seed, p.settings, coalesce(p.run_id, 0), coalesce(r.status, ''), "
+      "coalesce(r.reason, '') FROM campaign_points p LEFT JOIN runs r ON r.id = p.run_id "
+      "WHERE p.campaign_id = ? ORDER BY p.point, p.seed");
+  t.bind(1, c.id);
+  while (t.step()) {
+    TaskRow row{static_cast<int>(t.integer(0)),
+                t.integer(1),
+                t.integer(3),
+                t.text(2),
+                t.text(4),
+                t.text(5)};
+    c.points[row.point] = row.settings;
+    c.tasks.push_back(std::move(row));
+  }
+  auto s = db.prepare(
+      "SELECT point, name, n, mean, std, ci95_low, ci95_high, unit FROM campaign_statistics "
+      "WHERE campaign_id = ?");
+  s.bind(1, c.id);
+  while (s.step()) {
+    StatisticRow row{s.integer(2), s.real(3), s.real(4), std::nullopt, std::nullopt, s.text(7)};
+    if (!s.isNull(5)) row.low = s.real(5), row.high = s.real(6);
+    c.statistics[{static_cast<int>(s.integer(0)), s.text(1)}] = row;
+  }
+  return c;
+}
+
+std::string interval(const StatisticRow& s) {
+  if (!s.low) return "&ndash;";
+  std::ostringstream o;
+  o << "[" << num(*s.low) << ", " << num(*s.high) << "]";
+  return o.str();
+}
+
+void tasksTable(std::ostream& body, const CampaignData& c) {
+  body << "<h2>Tasks</h2>\n<table><tr><th>point</th><th>settings</th><th>seed</th><th>run</th>"
+          "<th>status</th></tr>\n";
+  for (const TaskRow& t : c.tasks) {
+    body << "<tr><td>" << t.point << "</td><td><code>" << html(t.settings) << "</code></td><td>"
+         << t.seed << "</td><td>" << (t.run ? std::to_string(t.run) : "&ndash;")
+         << "</td><td class=\"status-" << html(t.status) << "\">"
+         << (t.status.empty() ? "not run" : html(t.status))
+         << (t.reason.empty() ? "" : ": " + html(t.reason)) << "</td></tr>\n";
+  }
+  body << "</table>\n";
+}
+
+// Each point's key results over its seeds, as `campaign show` prints them; also as CSV.
+void keyResultsTable(std::ostream& body, const CampaignData& c,
+                     const std::vector<std::string>& keys, const std::string& out,
+                     ReportSummary& summary) {
+  std::ofstream csv(out + "/key-results.csv");
+  csv.precision(10);
+  csv << "point,settings,key_result,unit,n,mean,std,ci95_low,ci95_high\n";
+  body << "<h2>Key results</h2>\n<p>Per point over its completed runs: the mean, the sample "
+          "standard deviation (the scatter of one sample) and the 95% confidence interval of "
+          "the mean (Student t). Data: <a href=\"key-results.csv\">key-results.csv</a>.</p>\n"
+          "<table><tr><th>point</th><th>key result</th><th>n</th><th>mean</th><th>std</th>"
+          "<th>95% CI</th><th>unit</th></tr>\n";
+  for (const auto& [point, settings] : c.points) {
+    for (const std::string& key : keys) {
+      auto it = c.statistics.find({point, key});
+      body << "<tr><td>" << point << " <code>" << html(settings) << "</code></td><td>" << html(key)
+           << "</td>";
+      if (it == c.statistics.end()) {
+        body << "<td class=\"n\">0</td><td colspan=\"4\">not recorded</td></tr>\n";
+        continue;
+      }
+      const StatisticRow& s = it->second;
+      body << "<td class=\"n\">" << s.n << "</td><td class=\"n\">" << num(s.mean)
+           << "</td><td class=\"n\">" << num(s.std, 3) << "</td><td class=\"n\">" << interval(s)
+           << "</td><td>" << html(s.unit) << "</td></tr>\n";
+      std::string quoted = settings;
+      for (char& ch : quoted) {
+        if (ch == ',' || ch == '"') ch = ';';
+      }
+      csv << point << "," << quoted << "," << key << "," << s.unit << "," << s.n << "," << s.mean
+          << "," << s.std << ",";
+      if (s.low)
+        csv << *s.low << "," << *s.high;
+      else
+        csv << ",";
+      csv << "\n";
+    }
+  }
+  body << "</table>\n";
+  if (!csv) throw std::runtime_error("cannot write '" + out + "/key-results.csv'");
+  summary.files.push_back("key-results.csv");
+}
+
+// A point's figures: each run's built alone and combined, with the rig's own ensemble
+// figures in place of those of the same id.
+std::vector<Figure> pointFigures(const std::vector<const RunData*>& runs, const Paper& paper) {
+  const FigureEntry* entry = nullptr;
+  for (const FigureEntry& e : figureTable()) {
+    if (e.rig == runs.front()->rig) entry = &e;
+  }
+  if (!entry) return {};
+  std::vector<RunFigures> per_run;
+  for (const RunData* r : runs) per_run.push_back({r->id, entry->build({r}, paper)});
+  std::vector<Figure> out = combineFigures(per_run);
+  if (!entry->ensemble) return out;
+  for (Figure& own : entry->ensemble(runs, paper)) {
+    bool replaced = false;
+    for (Figure& f : out) {
+      if (f.id == own.id) f = own, replaced = true;
+    }
+    if (!replaced) out.push_back(std::move(own));
+  }
+  return out;
+}
+
+}  // namespace
+
+ReportSummary writeCampaignReport(const CampaignReportOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!fs::exists(o.lab)) throw std::invalid_argument("no lab notebook at '" + o.lab + "'");
+  notebook::Notebook nb(o.lab);
+  const CampaignData c = loadCampaign(nb, o.campaign);
+  std::map<int, std::vector<RunData>> runs;  // per point, its completed runs
+  for (const TaskRow& t : c.tasks) {
+    if (t.status == "completed") runs[t.point].push_back(loadRun(nb, t.run));
+  }
+  if (runs.empty()) {
+    throw std::invalid_argument("campaign '" + c.name + "' has no completed run in '" + o.lab +
+                                "' yet");
+  }
+  fs::create_directories(o.out);
+  const Paper paper = loadPaper(o.data_dir + "/paper.toml");
+  ReportSummary summary;
+  const RunData& any = runs.begin()->second.front();
+
+  std::ostringstream body;
+  body << "<h1>Campaign " << html(c.name) << "</h1>\n<p>Protocol <code>" << html(c.protocol)
+       << "</code> (" << html(any.rig) << "), " << c.points.size() << " points, " << c.tasks.size()
+       << " tasks; lab notebook <code>" << html(o.lab)
+       << "</code>.</p>\n<details><summary>Campaign file <code>" << html(c.file)
+       << "</code></summary><pre>" << html(c.text) << "</pre></details>\n";
+  tasksTable(body, c);
+  keyResultsTable(body, c, keyResultNames(any), o.out, summary);
+  body << "<h2>Figures</h2>\n";
+  for (const auto& [point, point_runs] : runs) {
+    body << "<h3>Point " << point << ": <code>" << html(c.points.at(point)) << "</code>, "
+         << point_runs.size() << " completed runs</h3>\n";
+    std::vector<const RunData*> ptrs;
+    for (const RunData& r : point_runs) ptrs.push_back(&r);
+    for (Figure f : pointFigures(ptrs, paper)) {
+      f.id = "point" + std::to_string(point) + "-" + f.id;
+      writeFigure(f, o.out, body, summary);
+    }
+  }
+  std::ofstream index(o.out + "/index.html");
+  index << page("rocklab campaign " + c.name, body.str());
+  if (!index) throw std::runtime_error("cannot write '" + o.out + "/index.html'");
+  summary.files.push_back("index.html");
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return summary;
+}
+
+}  // namespace rocklab::reports
