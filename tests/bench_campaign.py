@@ -2,9 +2,9 @@
 """What a campaign costs besides its runs, and what the local pool gains (issue 26).
 
   tests/bench_campaign.py [--rocklab build/release/rocklab] [--out build/bench-campaign]
-                          [--repeat 3]
+                          [--repeat 3] [--protocol protocols/hydrostatic-quick.toml]
 
-1. Speed-up: eight one-thread runs of protocols/hydrostatic-quick.toml (seeds 1 to 8), one
+1. Speed-up: eight one-thread runs of the protocol (seeds 1 to 8), one
    after another with `rocklab run`, against the same eight as `campaign run --jobs 2`;
    the two alternate, `--repeat` times each, and the medians are compared.
 2. Overhead per run (start, shard, merge): a `campaign run --jobs 1` of the eight, its wall
@@ -25,7 +25,6 @@ import uuid
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(HERE)
-PROTOCOL = os.path.join(SOURCE, "protocols", "hydrostatic-quick.toml")
 
 
 def run(args):
@@ -47,13 +46,16 @@ def main():
     ap.add_argument("--rocklab", default=os.path.join(SOURCE, "build", "release", "rocklab"))
     ap.add_argument("--out", default=os.path.join(SOURCE, "build", "bench-campaign"))
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--protocol", default=os.path.join(SOURCE, "protocols", "hydrostatic-quick.toml"),
+                    help="a quick protocol: the shorter its runs, the more the overhead weighs")
     a = ap.parse_args()
+    protocol = os.path.abspath(a.protocol)
     os.makedirs(a.out, exist_ok=True)
     rl = a.rocklab
     campaign = os.path.join(a.out, "eight.toml")
     with open(campaign, "w") as f:
         f.write('[campaign]\nname = "eight"\nprotocol = "%s"\nseeds = [1, 2, 3, 4, 5, 6, 7, 8]\n'
-                'threads = 1\n' % PROTOCOL)
+                'threads = 1\n' % protocol)
     lab = os.path.join(a.out, "lab.sqlite")
 
     sequential, pooled = [], []
@@ -61,7 +63,7 @@ def main():
         fresh(lab)
         t = 0.0
         for seed in range(1, 9):
-            t += run([rl, "run", PROTOCOL, "--quiet", "--threads", "1", "--set",
+            t += run([rl, "run", protocol, "--quiet", "--threads", "1", "--set",
                       "protocol.seed=%d" % seed, "--lab", lab])
         sequential.append(t)
         fresh(lab)
@@ -79,7 +81,8 @@ def main():
 
     one = os.path.join(a.out, "one.sqlite")
     fresh(one)
-    run([rl, "run", PROTOCOL, "--quiet", "--set", "sample.count=300", "--lab", one])
+    run([rl, "run", os.path.join(SOURCE, "protocols", "hydrostatic-quick.toml"), "--quiet",
+         "--set", "sample.count=300", "--lab", one])
     shards = []
     for k in range(100):
         s = os.path.join(a.out, "shard-%03d.sqlite" % k)
