@@ -224,22 +224,16 @@ std::optional<std::vector<std::vector<const Series*>>> matchSeries(
   return out;
 }
 
-std::optional<Figure> combineFigure(const std::vector<const Figure*>& members) {
-  Figure out = *members.front();
-  for (const Figure* f : members) {
-    if (f->panels.size() != out.panels.size()) return std::nullopt;
-  }
-  for (std::size_t p = 0; p < out.panels.size(); ++p) {
-    std::vector<const Panel*> panels;
-    for (const Figure* f : members) panels.push_back(&f->panels[p]);
-    const auto matched = matchSeries(panels);
-    if (!matched) return std::nullopt;
-    out.panels[p].series.clear();
-    for (const auto& group : *matched) {
-      std::optional<Series> s = combineSeries(group);
-      if (!s) return std::nullopt;
-      out.panels[p].series.push_back(std::move(*s));
-    }
+// One panel over the runs: each series combined, or none when some series cannot be.
+std::optional<Panel> combinePanel(const std::vector<const Panel*>& panels) {
+  const auto matched = matchSeries(panels);
+  if (!matched) return std::nullopt;
+  Panel out = *panels.front();
+  out.series.clear();
+  for (const auto& group : *matched) {
+    std::optional<Series> s = combineSeries(group);
+    if (!s) return std::nullopt;
+    out.series.push_back(std::move(*s));
   }
   return out;
 }
@@ -299,32 +293,62 @@ std::vector<Figure> combineFigures(const std::vector<RunFigures>& runs) {
     for (const Figure& f : r.figures) figures.push_back(figureWithoutRun(f, r.run));
     named.push_back(std::move(figures));
   }
-  const std::string over = "Over " + std::to_string(runs.size()) + " seeds (runs " + runList(runs) +
-                           "): each curve is the mean of the runs' curves on a common abscissa, "
-                           "over the range every run reached, and its band one standard "
-                           "deviation either side; each point the "
-                           "mean of the runs' with a bar of one standard deviation; numbers "
-                           "in a legend are mean +- standard deviation.";
+  const std::string list = runList(runs);
   for (const Figure& first : named.front()) {
-    std::vector<const Figure*> members;
-    for (const auto& figures : named) {
-      for (const Figure& f : figures) {
-        if (f.id == first.id) members.push_back(&f);
+    // Each run's figure of this id, with its names (for a mean) and as the run drew it (to
+    // overlay a panel a mean would misstate).
+    std::vector<const Figure*> members, originals;
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      for (std::size_t k = 0; k < named[r].size(); ++k) {
+        if (named[r][k].id != first.id) continue;
+        members.push_back(&named[r][k]);
+        originals.push_back(&runs[r].figures[k]);
       }
     }
-    std::optional<Figure> combined;
-    if (members.size() == runs.size() && runs.size() > 1) combined = combineFigure(members);
-    if (combined) {
-      combined->caption += " " + over;
-      out.push_back(std::move(*combined));
-      continue;
+    bool same_panels = members.size() == runs.size() && runs.size() > 1;
+    for (const Figure* f : members)
+      same_panels = same_panels && f->panels.size() == first.panels.size();
+    Figure f = first;
+    std::vector<std::size_t> overlaid;
+    for (std::size_t p = 0; p < f.panels.size(); ++p) {
+      std::optional<Panel> combined;
+      if (same_panels) {
+        std::vector<const Panel*> panels;
+        for (const Figure* m : members) panels.push_back(&m->panels[p]);
+        combined = combinePanel(panels);
+      }
+      if (combined) {
+        f.panels[p] = std::move(*combined);
+        continue;
+      }
+      // The runs' series as each labelled them, drawn together.
+      f.panels[p].series.clear();
+      for (const Figure* o : originals) {
+        if (p >= o->panels.size()) continue;
+        const auto& series = o->panels[p].series;
+        f.panels[p].series.insert(f.panels[p].series.end(), series.begin(), series.end());
+      }
+      overlaid.push_back(p + 1);
     }
-    Figure one = first;
-    one.caption += " One seed's (run " + std::to_string(runs.front().run) +
-                   "): the seeds' figures differ in shape (other branches or point counts), "
-                   "so they are not averaged; `rocklab report " +
-                   runList(runs) + "` overlays them.";
-    out.push_back(std::move(one));
+    if (overlaid.size() < f.panels.size()) {
+      f.caption += " Over " + std::to_string(runs.size()) + " seeds (runs " + list +
+                   "): each curve is the mean of the runs' curves on a common abscissa, over "
+                   "the range every run reached, and its band one standard deviation either "
+                   "side; each point the mean of the runs' with a bar of one standard "
+                   "deviation; numbers in a legend are mean +- standard deviation.";
+    }
+    if (!overlaid.empty()) {
+      std::string which;
+      for (std::size_t p : overlaid) {
+        if (!which.empty()) which += ", ";
+        which += std::to_string(p);
+      }
+      f.caption += overlaid.size() == f.panels.size() ? " The" : " In panel " + which + ", the";
+      f.caption += " seeds' runs (" + list +
+                   ") are overlaid: their curves differ in shape (other branches, abscissa "
+                   "ranges that do not meet, other point counts), so they are not averaged.";
+    }
+    out.push_back(std::move(f));
   }
   return out;
 }

@@ -22,8 +22,8 @@ struct RunFigures {
 // place (or, when the runs' panels hold different series, by label), curves averaged on a
 // common abscissa branch by branch (a loading, an unloading: the abscissa's monotonic runs),
 // points point by point. Numbers that differ between the runs' labels become "mean +- std".
-// A figure whose runs differ in shape (other branches, other point counts) is the first
-// run's, its caption saying so.
+// A figure whose runs differ in shape (other branches, abscissa ranges that do not meet,
+// other point counts) has the runs' series overlaid instead, its caption saying so.
 std::vector<Figure> combineFigures(const std::vector<RunFigures>& runs);
 
 // A text with its mention of a run removed: "run 12 " and "-run12".

@@ -168,7 +168,7 @@ TEST(Ensembles, CurvesAreAveragedBranchByBranchAndPointsPointByPoint) {
     Figure f{"stress-run" + std::to_string(a),
              "Stress, run " + std::to_string(a) + " ucs",
              "Caption.",
-             {Panel{"strain", "stress", {curve, fit, paper}}}};
+             {Panel{"strain", "stress", {curve, fit, paper}}, Panel{"strain", "y", {curve}}}};
     runs.push_back({a, {f}});
   }
   const std::vector<Figure> out = combineFigures(runs);
@@ -197,12 +197,22 @@ TEST(Ensembles, CurvesAreAveragedBranchByBranchAndPointsPointByPoint) {
   EXPECT_NEAR(fit.high[1] - fit.y[1], 20.0, 1e-9);  // of 20, 40, 60
   EXPECT_TRUE(f.panels[0].series[2].low.empty());   // the paper's: no spread
 
-  // A seed whose points differ in number: the figure is the first run's and says why.
+  EXPECT_EQ(f.panels.at(1).series.at(0).x.size(), 240u);
+
+  // A seed whose points differ in number: that panel has the runs' series overlaid, as each
+  // labelled them; the other is still their mean.
   runs[2].figures[0].panels[0].series[1].x.push_back(3.0);
   runs[2].figures[0].panels[0].series[1].y.push_back(90.0);
-  const Figure one = combineFigures(runs).front();
-  EXPECT_NE(one.caption.find("One seed's (run 1)"), std::string::npos) << one.caption;
-  EXPECT_TRUE(one.panels[0].series[0].low.empty());
+  const Figure part = combineFigures(runs).front();
+  EXPECT_NE(part.caption.find("In panel 1, the seeds' runs (1, 2, 3) are overlaid"),
+            std::string::npos)
+      << part.caption;
+  EXPECT_NE(part.caption.find("Over 3 seeds"), std::string::npos);
+  ASSERT_EQ(part.panels[0].series.size(), 9u);
+  EXPECT_EQ(part.panels[0].series[3].label, "run 2 loading");
+  EXPECT_TRUE(part.panels[0].series[0].low.empty());
+  EXPECT_EQ(part.panels[1].series.size(), 1u);
+  EXPECT_FALSE(part.panels[1].series[0].low.empty());
 }
 
 // A lattice of 7^3 spheres (an odd count: the mid-plane cuts a layer through its centres),
