@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <type_traits>
 
 #include "lab/core/bond_lanes.hpp"
 #include "lab/core/contact_model.hpp"
@@ -174,27 +175,31 @@ void BondForces<D>::compute(BondPass<D>& pass) {
   for (std::size_t blk = 0; blk < blocks; ++blk) {
     const std::size_t end = std::min(nb, (blk + 1) * kBlockRows);
     std::size_t b = blk * kBlockRows;
-    if constexpr (D == 3) {
-      if (pass.lanes && lanes::available()) {
-        // Each group is settled after the next one is computed: its results are ready by
-        // then, and its scalar scatter overlaps the tail of the next group's chain.
-        lanes::Settled s[2];
-        auto settleFour = [&](std::size_t first, const lanes::Settled& r) {
-          for (int k = 0; k < 4; ++k) {
+    if (pass.lanes && lanes::available()) {
+      // Each group is settled after the next one is computed: its results are ready by
+      // then, and its scalar scatter overlaps the tail of the next group's chain.
+      using Settled = std::conditional_t<D == 3, lanes::Settled, lanes::Settled2>;
+      Settled s[2];
+      auto settleFour = [&](std::size_t first, const Settled& r) {
+        for (int k = 0; k < 4; ++k) {
+          if constexpr (D == 3) {
             settle(blk, first + k, Vec<3>(r.force[0][k], r.force[1][k], r.force[2][k]),
                    Ang<3>(r.ti[0][k], r.ti[1][k], r.ti[2][k]),
                    Ang<3>(r.tj[0][k], r.tj[1][k], r.tj[2][k]), r.tensile[k], r.shear[k]);
+          } else {
+            settle(blk, first + k, Vec<2>(r.force[0][k], r.force[1][k]), r.ti[k], r.tj[k],
+                   r.tensile[k], r.shear[k]);
           }
-        };
-        const std::size_t first = b;
-        for (; b + 4 <= end; b += 4) {
-          lanes::fourBonds(P, B, b, dt, s[(b / 4) & 1]);
-          if (b > first) settleFour(b - 4, s[((b - 4) / 4) & 1]);
         }
+      };
+      const std::size_t first = b;
+      for (; b + 4 <= end; b += 4) {
+        lanes::fourBonds(P, B, b, dt, s[(b / 4) & 1]);
         if (b > first) settleFour(b - 4, s[((b - 4) / 4) & 1]);
       }
+      if (b > first) settleFour(b - 4, s[((b - 4) / 4) & 1]);
     }
-    for (; b < end; ++b) one(blk, b);  // 2D, no AVX, or the block's last few bonds
+    for (; b < end; ++b) one(blk, b);  // no AVX, or the block's last few bonds
   }
 
   if (pass.threaded) {

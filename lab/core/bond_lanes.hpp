@@ -1,12 +1,12 @@
 #pragma once
-// Four 3D bonds at once, one per lane of an AVX register. The scalar bond pass is bound by
-// the latency of each bond's chain of roots and divisions (perf puts its samples on the
+// Four bonds at once, one per lane of an AVX register (3D, and 2D below). The scalar bond pass is
+// bound by the latency of each bond's chain of roots and divisions (perf puts its samples on the
 // instructions waiting for them; sorting the bonds or prefetching their particles changed
 // nothing): a bond's ~480 instructions do not fit the out-of-order window, so bonds hardly
 // overlap. Four lanes run four chains side by side and quarter the arithmetic.
 //
-// Every lane performs the operations of BondSection<3>::of, bondForce<3> and
-// followContactFrame<3> in the same order, and each AVX operation (add, multiply, divide,
+// Every lane performs the operations of BondSection<D>::of, bondForce<D> and
+// followContactFrame<D> in the same order, and each AVX operation (add, multiply, divide,
 // square root) is the correctly rounded IEEE operation, as the scalar one; nothing is fused
 // (-ffp-contract=off, no FMA target). So a bond gets the same bits in a lane as on the
 // scalar path, and the benchmark's state hash holds. Where the scalar code branches, both
@@ -229,6 +229,117 @@ inline void fourBonds(const ParticleStore<3>& P, BondStore<3>& B, std::size_t b,
   }
   _mm256_store_pd(out.tensile, w.tensile.v);
   _mm256_store_pd(out.shear, w.shear.v);
+}
+
+// The 2D pass: disks of thickness t, in-plane vectors and scalar spins and moments
+// (BondSection<2>: area 2 r t, inertia 2 r^3 t / 3; no twist, and the frame turns with the
+// normal only).
+struct V2 {
+  L4 x, y;
+};
+inline V2 operator+(const V2& a, const V2& b) {
+  return {a.x + b.x, a.y + b.y};
+}
+inline V2 operator-(const V2& a, const V2& b) {
+  return {a.x - b.x, a.y - b.y};
+}
+inline V2 operator*(L4 s, const V2& a) {
+  return {s * a.x, s * a.y};
+}
+inline V2 operator/(const V2& a, L4 s) {
+  return {a.x / s, a.y / s};
+}
+inline L4 dot(const V2& a, const V2& b) {  // Eigen's order: a0 b0 + a1 b1
+  return a.x * b.x + a.y * b.y;
+}
+inline V2 cross(L4 w, const V2& r) {  // w x r, dim.hpp
+  return {-w * r.y, w * r.x};
+}
+inline L4 cross(const V2& a, const V2& b) {  // the out-of-plane component, dim.hpp
+  return a.x * b.y - a.y * b.x;
+}
+inline V2 select(__m256d mask, const V2& a, const V2& b) {
+  return {select(mask, a.x, b.x), select(mask, a.y, b.y)};
+}
+inline V2 gather(const Eigen::Vector2d* a, const std::uint32_t (&idx)[4]) {
+  return {{_mm256_set_pd(a[idx[3]].x(), a[idx[2]].x(), a[idx[1]].x(), a[idx[0]].x())},
+          {_mm256_set_pd(a[idx[3]].y(), a[idx[2]].y(), a[idx[1]].y(), a[idx[0]].y())}};
+}
+
+// followContactFrame<2>: the spring leaves the normal's direction at its length, both
+// branches masked.
+inline void followContactFrame(V2& v, const V2& n) {
+  const L4 m2 = dot(v, v);
+  V2 w = v - dot(v, n) * n;
+  const L4 m2_new = dot(w, w);
+  const __m256d turned = _mm256_cmp_pd(m2_new.v, _mm256_setzero_pd(), _CMP_GT_OQ);
+  w = select(turned, sqrt(m2 / m2_new) * w, w);
+  v = select(_mm256_cmp_pd(m2.v, _mm256_setzero_pd(), _CMP_EQ_OQ), v, w);
+}
+
+// What the caller settles for each 2D bond of the group, lane k of each array.
+struct Settled2 {
+  alignas(32) double force[2][4];
+  alignas(32) double ti[4];
+  alignas(32) double tj[4];
+  alignas(32) double tensile[4];
+  alignas(32) double shear[4];
+};
+
+// Bonds b..b+3 of a 2D scene: the operations of the scalar path (BondForces::compute with
+// BondSection<2>::of and bondForce<2>), lane by lane; the loads are written back and the
+// outcome of each bond is left in `out`.
+inline void fourBonds(const ParticleStore<2>& P, BondStore<2>& B, std::size_t b, double dt,
+                      Settled2& out) {
+  const std::uint32_t is[4] = {B.i[b], B.i[b + 1], B.i[b + 2], B.i[b + 3]};
+  const std::uint32_t js[4] = {B.j[b], B.j[b + 1], B.j[b + 2], B.j[b + 3]};
+  const V2 d = gather(P.pos.data(), js) - gather(P.pos.data(), is);
+  const L4 dist = sqrt(dot(d, d));
+  const V2 n = d / dist;
+  const L4 ri = gather(P.radius.data(), is), rj = gather(P.radius.data(), js);
+  const L4 overlap = ri + rj - dist;  // < 0: a gap
+  const L4 li = ri - both(0.5) * overlap, lj = rj - both(0.5) * overlap;
+  const L4 si = gather(P.spin.data(), is), sj = gather(P.spin.data(), js);
+  const V2 vc = gather(P.vel.data(), js) - gather(P.vel.data(), is) - cross(lj * sj + li * si, n);
+  const L4 dspin = sj - si;
+
+  const L4 radius = load(&B.radius[b]), kn = load(&B.kn[b]), ks = load(&B.ks[b]);
+  const L4 t = both(P.thickness);
+  const L4 area = both(2.0) * radius * t;
+  const L4 inertia = both(2.0) * radius * radius * radius * t / both(3.0);
+  BondLoad<2>* l = &B.load[b];
+  L4 fn{_mm256_set_pd(l[3].fn, l[2].fn, l[1].fn, l[0].fn)};
+  V2 fs{{_mm256_set_pd(l[3].fs.x(), l[2].fs.x(), l[1].fs.x(), l[0].fs.x())},
+        {_mm256_set_pd(l[3].fs.y(), l[2].fs.y(), l[1].fs.y(), l[0].fs.y())}};
+  L4 mb{_mm256_set_pd(l[3].mb, l[2].mb, l[1].mb, l[0].mb)};
+
+  const L4 vn = dot(vc, n);
+  const V2 vt = vc - vn * n;
+  followContactFrame(fs, n);
+  fn = fn - kn * area * vn * both(dt);
+  fs = fs - (ks * area * both(dt)) * vt;
+  mb = mb - kn * inertia * dspin * both(dt);
+  const V2 force = fn * n + fs;
+  const L4 shear = sqrt(dot(fs, fs)) / area;
+  const L4 tensile = -fn / area + abs(mb) * radius / inertia;
+
+  alignas(32) double fn_out[4], fsx[4], fsy[4], mb_out[4];
+  _mm256_store_pd(fn_out, fn.v);
+  _mm256_store_pd(fsx, fs.x.v);
+  _mm256_store_pd(fsy, fs.y.v);
+  _mm256_store_pd(mb_out, mb.v);
+  for (int k = 0; k < 4; ++k) {
+    l[k].fn = fn_out[k];
+    l[k].fs = Eigen::Vector2d(fsx[k], fsy[k]);
+    l[k].mb = mb_out[k];
+  }
+  const L4 ncf = cross(n, fs);
+  _mm256_store_pd(out.force[0], force.x.v);
+  _mm256_store_pd(out.force[1], force.y.v);
+  _mm256_store_pd(out.ti, (li * ncf + mb).v);
+  _mm256_store_pd(out.tj, (mb - lj * ncf).v);
+  _mm256_store_pd(out.tensile, tensile.v);
+  _mm256_store_pd(out.shear, shear.v);
 }
 
 #pragma GCC pop_options

@@ -62,7 +62,7 @@ struct SimulationConfig {
   // false: bonds carry any load unbroken (an ultrasonic window: microseconds in which the
   // lab sample breaks nothing, while a DEM sample loaded fast keeps breaking for long).
   bool bond_breakage = true;
-  // false: 3D bonds one at a time. The four-lane pass (bond_lanes.hpp) gives the same bits,
+  // false: bonds one at a time. The four-lane pass (bond_lanes.hpp, 2D and 3D) gives the same bits,
   // so this only changes the speed; the tests compare the two.
   bool bond_lanes = true;
 
