@@ -362,6 +362,50 @@ TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
   EXPECT_LT((t1 - t0).norm(), 1e-9 * t0.norm());
 }
 
+// What a shaken bonded sample ends in, to compare the four-lane bond pass with the scalar one.
+template <int D>
+struct LaneOutcome {
+  std::vector<Vec<D>> pos, vel;
+  std::vector<Ang<D>> spin;
+  std::vector<BondLoad<D>> loads;
+  std::uint64_t broken = 0;
+  std::vector<double> break_stress;  // the stress that broke each bond, in order
+};
+
+template <int D>
+LaneOutcome<D> outcomeOf(const Simulation<D>& sim, std::uint32_t kind) {
+  LaneOutcome<D> o;
+  for (const auto& e : sim.bondBreaks()) o.break_stress.push_back(e.stress);
+  const auto& P = sim.particles();
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    o.pos.push_back(P.pos[i]), o.vel.push_back(P.vel[i]), o.spin.push_back(P.spin[i]);
+  }
+  o.loads = sim.bonds().load;
+  o.broken =
+      sim.brokenBonds(kind, BondBreakMode::Tensile) + sim.brokenBonds(kind, BondBreakMode::Shear);
+  EXPECT_GT(sim.brokenBonds(kind, BondBreakMode::Tensile), 0u);
+  EXPECT_GT(sim.brokenBonds(kind, BondBreakMode::Shear), 0u);
+  return o;
+}
+
+template <int D>
+void expectSameBits(const LaneOutcome<D>& scalar, const LaneOutcome<D>& four) {
+  EXPECT_GT(scalar.broken, 10u);
+  EXPECT_EQ(four.broken, scalar.broken);
+  EXPECT_EQ(four.break_stress, scalar.break_stress);
+  ASSERT_EQ(four.pos.size(), scalar.pos.size());
+  for (std::size_t i = 0; i < scalar.pos.size(); ++i) {
+    ASSERT_EQ(four.pos[i], scalar.pos[i]) << "particle " << i;
+    ASSERT_EQ(four.vel[i], scalar.vel[i]) << "particle " << i;
+    ASSERT_EQ(four.spin[i], scalar.spin[i]) << "particle " << i;
+  }
+  ASSERT_EQ(four.loads.size(), scalar.loads.size());
+  for (std::size_t b = 0; b < scalar.loads.size(); ++b) {
+    const BondLoad<D>&l = four.loads[b], &r = scalar.loads[b];
+    ASSERT_TRUE(l.fn == r.fn && l.fs == r.fs && l.mb == r.mb && l.mt == r.mt) << "bond " << b;
+  }
+}
+
 // The four-lane bond pass (bond_lanes.hpp) against bonds one at a time, bit for bit: a
 // jittered lattice of 7 x 5 x 4 spheres (bonds with gaps and overlaps, a count that leaves
 // a scalar tail after the groups of four), shaken with random velocities and spins so that
@@ -369,12 +413,6 @@ TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
 // with masked loads). With a friction angle and a moment factor, the shear strengths and
 // the peak stresses come from the loads the lanes stored.
 TEST(BondLanes, FourPerRegisterGiveTheScalarBits) {
-  struct Outcome {
-    std::vector<V3> pos, vel, spin;
-    std::vector<BondLoad<3>> loads;
-    std::uint64_t broken = 0;
-    std::vector<double> break_stress;  // the stress that broke each bond, in order
-  };
   auto run = [](bool lanes) {
     SimulationConfig cfg = testing::undamped();
     cfg.timestep.automatic = false;
@@ -403,44 +441,15 @@ TEST(BondLanes, FourPerRegisterGiveTheScalarBits) {
       P.vel[i] = 0.05 * V3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
       P.spin[i] = 50 * V3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
     }
-    Outcome o;
     for (int s = 0; s < 400; ++s) sim.step();
-    for (const auto& e : sim.bondBreaks()) o.break_stress.push_back(e.stress);
-    for (std::size_t i = 0; i < P.size(); ++i) {
-      o.pos.push_back(P.pos[i]), o.vel.push_back(P.vel[i]), o.spin.push_back(P.spin[i]);
-    }
-    o.loads = sim.bonds().load;
-    o.broken =
-        sim.brokenBonds(kind, BondBreakMode::Tensile) + sim.brokenBonds(kind, BondBreakMode::Shear);
-    return o;
+    return outcomeOf(sim, kind);
   };
-  const Outcome scalar = run(false), four = run(true);
-  EXPECT_GT(scalar.broken, 10u);
-  EXPECT_EQ(four.broken, scalar.broken);
-  EXPECT_EQ(four.break_stress, scalar.break_stress);
-  ASSERT_EQ(four.pos.size(), scalar.pos.size());
-  for (std::size_t i = 0; i < scalar.pos.size(); ++i) {
-    ASSERT_EQ(four.pos[i], scalar.pos[i]) << "particle " << i;
-    ASSERT_EQ(four.vel[i], scalar.vel[i]) << "particle " << i;
-    ASSERT_EQ(four.spin[i], scalar.spin[i]) << "particle " << i;
-  }
-  ASSERT_EQ(four.loads.size(), scalar.loads.size());
-  for (std::size_t b = 0; b < scalar.loads.size(); ++b) {
-    const BondLoad<3>&l = four.loads[b], &r = scalar.loads[b];
-    ASSERT_TRUE(l.fn == r.fn && l.fs == r.fs && l.mb == r.mb && l.mt == r.mt) << "bond " << b;
-  }
+  expectSameBits(run(false), run(true));
 }
 
 // The 2D four-lane pass against bonds one at a time, bit for bit, as the 3D one above: a
 // jittered lattice of 11 x 9 disks shaken so that bonds break in both modes.
 TEST(BondLanes, FourPerRegisterGiveTheScalarBitsIn2D) {
-  struct Outcome {
-    std::vector<V2> pos, vel;
-    std::vector<double> spin;
-    std::vector<BondLoad<2>> loads;
-    std::uint64_t broken = 0;
-    std::vector<double> break_stress;
-  };
   auto run = [](bool lanes) {
     SimulationConfig cfg = testing::undamped();
     cfg.timestep.automatic = false;
@@ -468,34 +477,10 @@ TEST(BondLanes, FourPerRegisterGiveTheScalarBitsIn2D) {
       P.vel[i] = 0.2 * V2(rng.uniform(-1, 1), rng.uniform(-1, 1));
       P.spin[i] = 200 * rng.uniform(-1, 1);
     }
-    Outcome o;
     for (int s = 0; s < 400; ++s) sim.step();
-    for (const auto& e : sim.bondBreaks()) o.break_stress.push_back(e.stress);
-    for (std::size_t i = 0; i < P.size(); ++i) {
-      o.pos.push_back(P.pos[i]), o.vel.push_back(P.vel[i]), o.spin.push_back(P.spin[i]);
-    }
-    o.loads = sim.bonds().load;
-    o.broken =
-        sim.brokenBonds(kind, BondBreakMode::Tensile) + sim.brokenBonds(kind, BondBreakMode::Shear);
-    EXPECT_GT(sim.brokenBonds(kind, BondBreakMode::Tensile), 0u);
-    EXPECT_GT(sim.brokenBonds(kind, BondBreakMode::Shear), 0u);
-    return o;
+    return outcomeOf(sim, kind);
   };
-  const Outcome scalar = run(false), four = run(true);
-  EXPECT_GT(scalar.broken, 10u);
-  EXPECT_EQ(four.broken, scalar.broken);
-  EXPECT_EQ(four.break_stress, scalar.break_stress);
-  ASSERT_EQ(four.pos.size(), scalar.pos.size());
-  for (std::size_t i = 0; i < scalar.pos.size(); ++i) {
-    ASSERT_EQ(four.pos[i], scalar.pos[i]) << "particle " << i;
-    ASSERT_EQ(four.vel[i], scalar.vel[i]) << "particle " << i;
-    ASSERT_EQ(four.spin[i], scalar.spin[i]) << "particle " << i;
-  }
-  ASSERT_EQ(four.loads.size(), scalar.loads.size());
-  for (std::size_t b = 0; b < scalar.loads.size(); ++b) {
-    const BondLoad<2>&l = four.loads[b], &r = scalar.loads[b];
-    ASSERT_TRUE(l.fn == r.fn && l.fs == r.fs && l.mb == r.mb && l.mt == r.mt) << "bond " << b;
-  }
+  expectSameBits(run(false), run(true));
 }
 
 TEST(Bonds, KindsAreValidated) {
