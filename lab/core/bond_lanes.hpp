@@ -182,55 +182,6 @@ struct Bonds4 {
   }
 };
 
-// What the caller settles for each bond of the group, lane k of each array.
-struct Settled {
-  alignas(32) double force[3][4];
-  alignas(32) double ti[3][4];
-  alignas(32) double tj[3][4];
-  alignas(32) double tensile[4];
-  alignas(32) double shear[4];
-};
-
-// Bonds b..b+3: the operations of the scalar path (BondForces::compute), lane by lane; the
-// loads are written back and the outcome of each bond is left in `out`.
-inline void fourBonds(const ParticleStore<3>& P, BondStore<3>& B, std::size_t b, double dt,
-                      Settled& out) {
-  const std::uint32_t is[4] = {B.i[b], B.i[b + 1], B.i[b + 2], B.i[b + 3]};
-  const std::uint32_t js[4] = {B.j[b], B.j[b + 1], B.j[b + 2], B.j[b + 3]};
-  const V3 d = gather(P.pos.data(), js) - gather(P.pos.data(), is);
-  const L4 dist = sqrt(dot(d, d));
-  const V3 n = d / dist;
-  const L4 ri = gather(P.radius.data(), is), rj = gather(P.radius.data(), js);
-  const L4 overlap = ri + rj - dist;  // < 0: a gap
-  const L4 li = ri - both(0.5) * overlap, lj = rj - both(0.5) * overlap;
-  const V3 si = gather(P.spin.data(), is), sj = gather(P.spin.data(), js);
-  const V3 vc = gather(P.vel.data(), js) - gather(P.vel.data(), is) - cross(lj * sj + li * si, n);
-  const V3 dspin = sj - si;
-  const L4 spin_n = both(0.5) * dot(si + sj, n);
-
-  Bonds4 w;
-  w.radius = load(&B.radius[b]), w.kn = load(&B.kn[b]), w.ks = load(&B.ks[b]);
-  L4 stored[8];  // fn, fs, mb, mt
-  gather(&B.load[b], stored);
-  w.fn = stored[0], w.fs = {stored[1], stored[2], stored[3]};
-  w.mb = {stored[4], stored[5], stored[6]}, w.mt = stored[7];
-  w.step(n, vc, dspin, spin_n, dt);
-  const L4 updated[8] = {w.fn, w.fs.x, w.fs.y, w.fs.z, w.mb.x, w.mb.y, w.mb.z, w.mt};
-  scatter(updated, &B.load[b]);
-
-  const V3 ncf = cross(n, w.fs);
-  const V3 ti = li * ncf + w.moment, tj = w.moment - lj * ncf;
-  const V3* vectors[3] = {&w.force, &ti, &tj};
-  double(*const dest[3])[4] = {out.force, out.ti, out.tj};
-  for (int v = 0; v < 3; ++v) {
-    _mm256_store_pd(dest[v][0], vectors[v]->x.v);
-    _mm256_store_pd(dest[v][1], vectors[v]->y.v);
-    _mm256_store_pd(dest[v][2], vectors[v]->z.v);
-  }
-  _mm256_store_pd(out.tensile, w.tensile.v);
-  _mm256_store_pd(out.shear, w.shear.v);
-}
-
 // The 2D pass: disks of thickness t, in-plane vectors and scalar spins and moments
 // (BondSection<2>: area 2 r t, inertia 2 r^3 t / 3; no twist, and the frame turns with the
 // normal only).
@@ -277,6 +228,72 @@ inline void followContactFrame(V2& v, const V2& n) {
   v = select(_mm256_cmp_pd(m2.v, _mm256_setzero_pd(), _CMP_EQ_OQ), v, w);
 }
 
+// The kinematics of bonds b..b+3, as the scalar pass's (BondForces::compute): the normal,
+// the contact point's relative velocity, the spins and the lever arms (gaps and overlaps
+// shared halfway). V is V3 or V2, S the spins' V3 or L4.
+template <class V, class S>
+struct Kinematics4 {
+  V n, vc;
+  S si, sj;
+  L4 li, lj;
+};
+
+template <class V, class S, int D>
+inline Kinematics4<V, S> kinematics(const ParticleStore<D>& P, const BondStore<D>& B,
+                                    std::size_t b) {
+  const std::uint32_t is[4] = {B.i[b], B.i[b + 1], B.i[b + 2], B.i[b + 3]};
+  const std::uint32_t js[4] = {B.j[b], B.j[b + 1], B.j[b + 2], B.j[b + 3]};
+  const V d = gather(P.pos.data(), js) - gather(P.pos.data(), is);
+  const L4 dist = sqrt(dot(d, d));
+  const V n = d / dist;
+  const L4 ri = gather(P.radius.data(), is), rj = gather(P.radius.data(), js);
+  const L4 overlap = ri + rj - dist;  // < 0: a gap
+  const L4 li = ri - both(0.5) * overlap, lj = rj - both(0.5) * overlap;
+  const S si = gather(P.spin.data(), is), sj = gather(P.spin.data(), js);
+  const V vc = gather(P.vel.data(), js) - gather(P.vel.data(), is) - cross(lj * sj + li * si, n);
+  return {n, vc, si, sj, li, lj};
+}
+
+// What the caller settles for each bond of the group, lane k of each array.
+struct Settled {
+  alignas(32) double force[3][4];
+  alignas(32) double ti[3][4];
+  alignas(32) double tj[3][4];
+  alignas(32) double tensile[4];
+  alignas(32) double shear[4];
+};
+
+// Bonds b..b+3: the operations of the scalar path (BondForces::compute), lane by lane; the
+// loads are written back and the outcome of each bond is left in `out`.
+inline void fourBonds(const ParticleStore<3>& P, BondStore<3>& B, std::size_t b, double dt,
+                      Settled& out) {
+  const auto [n, vc, si, sj, li, lj] = kinematics<V3, V3>(P, B, b);
+  const V3 dspin = sj - si;
+  const L4 spin_n = both(0.5) * dot(si + sj, n);
+
+  Bonds4 w;
+  w.radius = load(&B.radius[b]), w.kn = load(&B.kn[b]), w.ks = load(&B.ks[b]);
+  L4 stored[8];  // fn, fs, mb, mt
+  gather(&B.load[b], stored);
+  w.fn = stored[0], w.fs = {stored[1], stored[2], stored[3]};
+  w.mb = {stored[4], stored[5], stored[6]}, w.mt = stored[7];
+  w.step(n, vc, dspin, spin_n, dt);
+  const L4 updated[8] = {w.fn, w.fs.x, w.fs.y, w.fs.z, w.mb.x, w.mb.y, w.mb.z, w.mt};
+  scatter(updated, &B.load[b]);
+
+  const V3 ncf = cross(n, w.fs);
+  const V3 ti = li * ncf + w.moment, tj = w.moment - lj * ncf;
+  const V3* vectors[3] = {&w.force, &ti, &tj};
+  double(*const dest[3])[4] = {out.force, out.ti, out.tj};
+  for (int v = 0; v < 3; ++v) {
+    _mm256_store_pd(dest[v][0], vectors[v]->x.v);
+    _mm256_store_pd(dest[v][1], vectors[v]->y.v);
+    _mm256_store_pd(dest[v][2], vectors[v]->z.v);
+  }
+  _mm256_store_pd(out.tensile, w.tensile.v);
+  _mm256_store_pd(out.shear, w.shear.v);
+}
+
 // What the caller settles for each 2D bond of the group, lane k of each array.
 struct Settled2 {
   alignas(32) double force[2][4];
@@ -291,16 +308,7 @@ struct Settled2 {
 // outcome of each bond is left in `out`.
 inline void fourBonds(const ParticleStore<2>& P, BondStore<2>& B, std::size_t b, double dt,
                       Settled2& out) {
-  const std::uint32_t is[4] = {B.i[b], B.i[b + 1], B.i[b + 2], B.i[b + 3]};
-  const std::uint32_t js[4] = {B.j[b], B.j[b + 1], B.j[b + 2], B.j[b + 3]};
-  const V2 d = gather(P.pos.data(), js) - gather(P.pos.data(), is);
-  const L4 dist = sqrt(dot(d, d));
-  const V2 n = d / dist;
-  const L4 ri = gather(P.radius.data(), is), rj = gather(P.radius.data(), js);
-  const L4 overlap = ri + rj - dist;  // < 0: a gap
-  const L4 li = ri - both(0.5) * overlap, lj = rj - both(0.5) * overlap;
-  const L4 si = gather(P.spin.data(), is), sj = gather(P.spin.data(), js);
-  const V2 vc = gather(P.vel.data(), js) - gather(P.vel.data(), is) - cross(lj * sj + li * si, n);
+  const auto [n, vc, si, sj, li, lj] = kinematics<V2, L4>(P, B, b);
   const L4 dspin = sj - si;
 
   const L4 radius = load(&B.radius[b]), kn = load(&B.kn[b]), ks = load(&B.ks[b]);

@@ -97,6 +97,14 @@ inline std::string campaignFile(const std::string& lab, const std::string& name,
   return path;
 }
 
+// A campaign of two seeds of a small sample that checkpoints often: a task killed or
+// cancelled a little into its run has a checkpoint to resume from.
+inline constexpr const char* kCheckpointedCampaign = R"(seeds = [3, 4]
+[set]
+"sample.count" = 400
+"output.checkpoint_every_s" = 0.2
+)";
+
 // Removes what a lab keeps beside its file: its runs' files and its campaigns' folders.
 inline void removeLabFiles(const Lab& lab) {
   std::filesystem::remove_all(lab.path + ".files");

@@ -139,11 +139,7 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
 // campaign makes.
 TEST(Campaigns, AKilledTaskIsListedAndResumedFromItsCheckpointOnRequest) {
   Lab lab("campaign-killed"), reference("campaign-reference");
-  const std::string body = R"(seeds = [3, 4]
-[set]
-"sample.count" = 400
-"output.checkpoint_every_s" = 0.2
-)";
+  const std::string body = kCheckpointedCampaign;
   const std::string file = campaignFile(lab.path, "killed", body);
   const std::string shard = lab.path + ".campaigns/killed/task-0.sqlite";
   const pid_t campaign = fork();

@@ -102,11 +102,7 @@ options = ["--mem=1G"]
 // the collect job merges it; --rerun-failed resumes it to the uninterrupted run.
 TEST_F(SlurmCluster, ATaskCancelledByTheSchedulerIsReportedAndResumed) {
   Lab lab("slurm-cancel"), reference("slurm-cancel-reference");
-  const std::string body = R"(seeds = [3, 4]
-[set]
-"sample.count" = 400
-"output.checkpoint_every_s" = 0.2
-)";
+  const std::string body = kCheckpointedCampaign;
   const std::string file = campaignFile(lab.path, "cancel", body);
   std::string out;
   ASSERT_EQ(runRocklab("campaign run " + file + " --scheduler slurm --lab " + lab.path, &out), 0)
