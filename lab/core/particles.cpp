@@ -37,6 +37,8 @@ ParticleId ParticleStore<D>::add(const ParticleSpec<D>& spec) {
   torque.push_back(angZero<A>());
   inv_mass.push_back(spec.fixed ? 0.0 : 1.0 / mass);
   inv_inertia.push_back(spec.fixed ? 0.0 : 1.0 / particleInertia<D>(mass, spec.radius));
+  physical_inv_mass.push_back(inv_mass.back());
+  physical_inv_inertia.push_back(inv_inertia.back());
   radius.push_back(spec.radius);
   material.push_back(spec.material);
   groups.push_back(spec.groups);
@@ -66,6 +68,7 @@ void ParticleStore<D>::remove(ParticleId id) {
   if (i != last) slot_index_[slot_of[last]] = static_cast<std::uint32_t>(i);
   move_last(pos), move_last(vel), move_last(force), move_last(spin), move_last(torque);
   move_last(inv_mass), move_last(inv_inertia), move_last(radius), move_last(material);
+  move_last(physical_inv_mass), move_last(physical_inv_inertia);
   move_last(groups), move_last(cluster), move_last(body), move_last(slot_of);
   slot_index_[id.slot] = kNoIndex;
   ++slot_generation_[id.slot];
@@ -82,6 +85,7 @@ void ParticleStore<D>::permute(const std::vector<std::uint32_t>& order) {
   };
   apply(pos), apply(vel), apply(force), apply(spin), apply(torque);
   apply(inv_mass), apply(inv_inertia), apply(radius), apply(material), apply(groups);
+  apply(physical_inv_mass), apply(physical_inv_inertia);
   apply(cluster), apply(body), apply(slot_of);
   for (std::size_t k = 0; k < slot_of.size(); ++k) {
     slot_index_[slot_of[k]] = static_cast<std::uint32_t>(k);

@@ -53,8 +53,14 @@ class ParticleStore {
   // Hot state: what the force and integration loops touch, contiguous per quantity.
   std::vector<V> pos, vel, force;
   std::vector<A> spin, torque;
+  // The inertial masses, what the forces accelerate: the physical ones below, or heavier under
+  // density scaling (Simulation::setDensityScaling); 0 for fixed and driven particles.
   std::vector<double> inv_mass, inv_inertia, radius;
   std::vector<std::uint16_t> material;  // read in the contact loop to mix pair parameters
+
+  // The physical masses (density times volume; a clump pebble's, its body's): what gravity
+  // pulls and what density scaling scales from. 0 for fixed particles.
+  std::vector<double> physical_inv_mass, physical_inv_inertia;
 
   // Cold metadata.
   std::vector<std::uint32_t> groups;
@@ -89,6 +95,11 @@ class ParticleStore {
   std::size_t slotCapacity() const { return slot_index_.size(); }
 
   double mass(std::size_t i) const { return inv_mass[i] > 0 ? 1.0 / inv_mass[i] : INFINITY; }
+  // Sets a particle's physical and inertial mass and moment of inertia (unscaled).
+  void setMass(std::size_t i, double mass, double inertia) {
+    inv_mass[i] = physical_inv_mass[i] = 1.0 / mass;
+    inv_inertia[i] = physical_inv_inertia[i] = 1.0 / inertia;
+  }
   double volume(std::size_t i) const { return particleVolume<D>(radius[i], thickness); }
 
   // Reorders every array so that new index k holds the particle that was at order[k].
@@ -100,6 +111,7 @@ class ParticleStore {
     ar("thickness", thickness);
     ar("pos", pos), ar("vel", vel), ar("force", force), ar("spin", spin), ar("torque", torque);
     ar("inv_mass", inv_mass), ar("inv_inertia", inv_inertia), ar("radius", radius);
+    ar("physical_inv_mass", physical_inv_mass), ar("physical_inv_inertia", physical_inv_inertia);
     ar("material", material), ar("groups", groups), ar("cluster", cluster);
     ar("body", body), ar("slot_of", slot_of);
     ar("slot_index", slot_index_), ar("slot_generation", slot_generation_);

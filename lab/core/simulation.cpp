@@ -178,7 +178,7 @@ void Simulation<D>::prepare() {
   }
   if (dt_ <= 0.0) {
     if (config_.timestep.automatic) {
-      dt_ = config_.timestep.safety * criticalTimeStep();
+      dt_ = automaticStep();
       if (!std::isfinite(dt_)) {
         throw std::invalid_argument(
             "the automatic time step needs at least one free (not fixed) particle; set "
@@ -242,7 +242,7 @@ void Simulation<D>::applyGravity(double dt) {
   };
   const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
     if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) return;  // clumps: whole bodies
-    const V f = g / P.inv_mass[i];
+    const V f = g / P.physical_inv_mass[i];  // the weight: density scaling adds only inertia
     P.force[i] += f;
     a.work += f.dot(P.vel[i]) * dt;  // exact over the drift x += v dt
   });
@@ -571,8 +571,64 @@ void Simulation<D>::step() {
   guard(overlap);
   if (config_.timestep.automatic &&
       step_ % static_cast<std::uint64_t>(config_.timestep.update_interval) == 0) {
-    const double dt = config_.timestep.safety * criticalTimeStep();
+    const double dt = automaticStep();
     if (std::isfinite(dt)) dt_ = dt;
+  }
+}
+
+template <int D>
+double Simulation<D>::automaticStep() {
+  const StepLimits limits = stepLimits();
+  double critical = limits.bodies;
+  for (const double own : limits.particle) critical = std::min(critical, own);
+  const double scaling = config_.timestep.density_scaling;
+  // Clumps keep their masses: they bound the target.
+  const double target = scaling > 1.0 ? std::min(scaling * critical, limits.bodies) : critical;
+  setInertialMasses(limits.particle, target);
+  return config_.timestep.safety * target;
+}
+
+// Each free particle's inertial mass and moment: the physical ones times (target / own)^2
+// where its own critical step is below the target (the step then meets its bound as the
+// lightest, stiffest particles set it without scaling), else the physical ones. The
+// velocities stay; the kinetic energy that changes with the masses goes to the ledger.
+template <int D>
+void Simulation<D>::setInertialMasses(const std::vector<double>& limits, double target) {
+  auto& P = particles_;
+  double added = 0.0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;  // fixed, driven, pebbles
+    const double own = limits[i];
+    const double scale = own < target ? (target / own) * (target / own) : 1.0;
+    const double inv_mass = scale == 1.0 ? P.physical_inv_mass[i] : P.physical_inv_mass[i] / scale;
+    const double inv_inertia =
+        scale == 1.0 ? P.physical_inv_inertia[i] : P.physical_inv_inertia[i] / scale;
+    if (inv_mass == P.inv_mass[i] && inv_inertia == P.inv_inertia[i]) continue;
+    added += 0.5 * (1.0 / inv_mass - 1.0 / P.inv_mass[i]) * P.vel[i].squaredNorm() +
+             0.5 * (1.0 / inv_inertia - 1.0 / P.inv_inertia[i]) * angDot(P.spin[i], P.spin[i]);
+    P.inv_mass[i] = inv_mass;
+    P.inv_inertia[i] = inv_inertia;
+  }
+  ledger_.mass_scaling += added;
+  ledger_.positive_input += std::max(added, 0.0);
+}
+
+template <int D>
+void Simulation<D>::setDensityScaling(double factor) {
+  requireRange("Simulation::setDensityScaling", "timestep.density_scaling", factor, 1.0, false,
+               16.0, false, "");
+  if (factor == config_.timestep.density_scaling) return;
+  config_.timestep.density_scaling = factor;
+  if (factor == 1.0) {  // the physical masses back, at once (no contact model needed)
+    const std::vector<double> unbounded(particles_.size(), INFINITY);
+    setInertialMasses(unbounded, 0.0);
+  }
+  if (!config_.timestep.automatic) return;
+  if (prepared_) {
+    const double dt = automaticStep();
+    if (std::isfinite(dt)) dt_ = dt;
+  } else {
+    dt_ = 0.0;  // prepare() sets it for the new scaling
   }
 }
 

@@ -9,6 +9,7 @@
 // change the run.
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -37,6 +38,12 @@ struct TimeStepConfig {
   double fixed_dt = 0.0;      // s, the step when not automatic
   double safety = 0.5;        // -, automatic step = safety * critical estimate
   int update_interval = 100;  // steps between critical-step estimates
+  // -, density scaling (PFC's practice for quasi-static runs): the automatic step is this
+  // times the critical estimate, and every free particle whose own critical step is shorter
+  // gets an inertial mass and moment heavier by (target / own)^2, so that none is less
+  // stable than at 1 (off). Equilibrium states do not depend on inertia; the path to them
+  // does, so it is for quasi-static stages only, its inertial number checked by the rig.
+  double density_scaling = 1.0;
 };
 
 struct GuardConfig {
@@ -73,6 +80,10 @@ struct SimulationConfig {
       contactLawChoices());
     f(timestep.safety, {"numerics.timestep_safety", units::none, Range::leftOpen(0, 1),
                         "time step over the critical estimate"});
+    f(timestep.density_scaling,
+      {"numerics.density_scaling", units::none, Range::closed(1, 16),
+       "quasi-static stages: the critical step over the lightest particles' own, reached by "
+       "heavier inertial masses where needed (1: off; never in wave windows)"});
     f(local_damping, {"numerics.local_damping", units::none, Range::rightOpen(0, 1),
                       "PFC local damping coefficient"});
     f(threads, {"numerics.threads", units::none, Range::closed(1, 1024),
@@ -97,6 +108,9 @@ struct EnergyLedger {
   // Kinetic energy lost when clumps broke into pebbles (each pebble keeps its velocity in
   // the body, but the pebbles' own masses differ from their share of the body's).
   double clump_release = 0.0;
+  // Kinetic energy the density scaling added (or took) when it changed inertial masses at
+  // unchanged velocities.
+  double mass_scaling = 0.0;
   double positive_input = 0.0;  // energy put in (for the runaway guard)
   bool started = false;
 };
@@ -111,7 +125,7 @@ struct EnergyReport {
   double imbalance() const {
     return kinetic() + strain + ledger.friction + ledger.viscous + ledger.local_damping +
            ledger.bond_breakage + ledger.clump_release -
-           (ledger.initial + ledger.boundary_work + ledger.body_work);
+           (ledger.initial + ledger.boundary_work + ledger.body_work + ledger.mass_scaling);
   }
 };
 
@@ -182,6 +196,9 @@ class Simulation {
   void setLocalDamping(double alpha) { config_.local_damping = alpha; }
   void setBondBreakage(bool on) { config_.bond_breakage = on; }
   void setFixedTimeStep(double dt);
+  // Density scaling from now on (TimeStepConfig::density_scaling; 1: the physical masses
+  // back, as a wave window needs). Takes effect at once when the simulation is prepared.
+  void setDensityScaling(double factor);
   // Replaces the materials (e.g. the friction after forming a sample); contact history and
   // bonds stay. The table must keep the indices particles and walls use.
   void replaceMaterials(MaterialTable materials);
@@ -254,9 +271,12 @@ class Simulation {
   double time() const { return time_; }
   double dt() const { return dt_; }
   std::uint64_t steps() const { return step_; }
-  // The critical time step estimate (s): min over particles of sqrt(m / sum kn) and
-  // sqrt(I / sum ks l^2) with tangent stiffnesses, and of the lone-particle bound.
+  // The critical time step estimate (s) with the physical masses: min over particles of
+  // sqrt(m / sum kn) and sqrt(I / sum ks l^2) with tangent stiffnesses, and of the
+  // lone-particle bound.
   double criticalTimeStep() const;
+  // Total inertial over total physical mass of the free particles: 1 without density scaling.
+  double inertialMassRatio() const;
   EnergyReport energy() const;
   // Mean particle-particle contacts per particle, 2 C / N (overlap > 0; walls excluded).
   double coordinationNumber() const;
@@ -280,8 +300,9 @@ class Simulation {
   void saveCheckpoint(const std::string& path) const;
   static Simulation loadCheckpoint(const std::string& path);
   // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle and moment_factor,
-  // 5 config.skin_ratio, 6 the applied forces.
-  static constexpr std::uint32_t kCheckpointVersion = 6;
+  // 5 config.skin_ratio, 6 the applied forces, 7 density scaling (the particles' physical
+  // masses, config.timestep.density_scaling, ledger.mass_scaling).
+  static constexpr std::uint32_t kCheckpointVersion = 7;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };
@@ -290,6 +311,17 @@ class Simulation {
   // does not advance (the set-up evaluation that velocity Verlet needs before its first
   // step); returns whether an overlap exceeded the guard's limit.
   bool computeForces(double history_dt);
+  // Each particle's own critical step (s; infinite for fixed particles and pebbles) with its
+  // physical mass, and the bound of the clumps (which are never scaled).
+  struct StepLimits {
+    std::vector<double> particle;
+    double bodies = INFINITY;
+  };
+  StepLimits stepLimits() const;
+  // The automatic step: safety times the critical estimate, or under density scaling times
+  // its target, with the inertial masses set for it.
+  double automaticStep();
+  void setInertialMasses(const std::vector<double>& limits, double target);
   void computeBondForces(double dt);
   void applyGravity(double dt);
   void applyForces(double dt);

@@ -32,8 +32,10 @@ std::uint32_t Simulation<D>::addClump(const std::vector<ParticleId>& pebbles, do
       throw std::invalid_argument("particle slot " + std::to_string(id.slot) +
                                   " is already a pebble of a clump");
     }
-    if (P.inv_mass[i] == 0.0) throw std::invalid_argument("a fixed particle cannot join a clump");
-    const double m = 1.0 / P.inv_mass[i], rho = m / P.volume(i);
+    if (P.inv_mass[i] == 0.0) {
+      throw std::invalid_argument("a fixed or driven particle cannot join a clump");
+    }
+    const double m = 1.0 / P.physical_inv_mass[i], rho = m / P.volume(i);
     if (density < 0.0) density = rho;
     if (std::abs(rho - density) > 1e-9 * density) {
       throw std::invalid_argument("the pebbles of a clump must have one density");
@@ -82,8 +84,9 @@ std::uint32_t Simulation<D>::addClump(const std::vector<ParticleId>& pebbles, do
   const V v = momentum / msum;
   A L = angZero<A>();
   for (const std::size_t i : members) {
-    const double m = 1.0 / P.inv_mass[i];
-    L += m * cross(V(P.pos[i] - mp.centroid), V(P.vel[i] - v)) + P.spin[i] / P.inv_inertia[i];
+    const double m = 1.0 / P.physical_inv_mass[i];
+    L += m * cross(V(P.pos[i] - mp.centroid), V(P.vel[i] - v)) +
+         P.spin[i] / P.physical_inv_inertia[i];
   }
   K.pos.push_back(mp.centroid);
   K.vel.push_back(v);
@@ -112,8 +115,7 @@ std::uint32_t Simulation<D>::addClump(const std::vector<ParticleId>& pebbles, do
     P.body[i] = c;
     // The body's mass and smallest moment: what a contact on the pebble moves (viscous
     // damping's effective mass).
-    P.inv_mass[i] = 1.0 / mp.mass;
-    P.inv_inertia[i] = 1.0 / imin;
+    P.setMass(i, mp.mass, imin);
   }
   K.first.push_back(static_cast<std::uint32_t>(K.member_slot.size()));
   placePebbles(c, false);
@@ -244,8 +246,7 @@ void Simulation<D>::releaseClump(std::uint32_t c) {
     const std::size_t i = P.indexOfSlot(K.member_slot[k]);
     const double m = density * P.volume(i), inertia = particleInertia<D>(m, P.radius[i]);
     P.body[i] = kNoBody;
-    P.inv_mass[i] = 1.0 / m;
-    P.inv_inertia[i] = 1.0 / inertia;
+    P.setMass(i, m, inertia);
     if (!damp_force_.empty()) {
       damp_force_[i].setZero();
       damp_torque_[i] = angZero<A>();

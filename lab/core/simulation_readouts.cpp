@@ -117,7 +117,7 @@ std::string Simulation<D>::diagnose() const {
 }
 
 template <int D>
-double Simulation<D>::criticalTimeStep() const {
+typename Simulation<D>::StepLimits Simulation<D>::stepLimits() const {
   const auto& P = particles_;
   const std::size_t n = P.size();
   if (!model_) throw std::logic_error("criticalTimeStep() before the simulation is prepared");
@@ -141,7 +141,8 @@ double Simulation<D>::criticalTimeStep() const {
       kr[p] += ks * P.radius[p] * P.radius[p] + moment;
     }
   }
-  double dt = INFINITY;
+  StepLimits limits;
+  double& dt = limits.bodies;
   // A clump's pebbles act in parallel on the body: their stiffnesses add up, the rotational
   // ones with the arm from the centroid (bounded by distance plus radius).
   const auto& K = clumps_;
@@ -169,16 +170,38 @@ double Simulation<D>::criticalTimeStep() const {
     if (kt_body > 0.0) dt = std::min(dt, std::sqrt(K.mass[c] / kt_body));
     if (kr_body > 0.0) dt = std::min(dt, std::sqrt(imin / kr_body));
   }
+  limits.particle.assign(n, INFINITY);
   for (std::size_t i = 0; i < n; ++i) {
     if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
-    const double m = 1.0 / P.inv_mass[i], inertia = 1.0 / P.inv_inertia[i];
-    dt = std::min(dt, model_->freeParticleStep(P.material[i],
-                                               pairShape<D>(P.radius[i], P.radius[i], P.thickness),
-                                               P.radius[i], m, inertia, m / P.volume(i)));
-    if (kt[i] > 0.0) dt = std::min(dt, std::sqrt(m / kt[i]));
-    if (kr[i] > 0.0) dt = std::min(dt, std::sqrt(inertia / kr[i]));
+    const double m = 1.0 / P.physical_inv_mass[i], inertia = 1.0 / P.physical_inv_inertia[i];
+    double& own = limits.particle[i];
+    own =
+        model_->freeParticleStep(P.material[i], pairShape<D>(P.radius[i], P.radius[i], P.thickness),
+                                 P.radius[i], m, inertia, m / P.volume(i));
+    if (kt[i] > 0.0) own = std::min(own, std::sqrt(m / kt[i]));
+    if (kr[i] > 0.0) own = std::min(own, std::sqrt(inertia / kr[i]));
   }
+  return limits;
+}
+
+template <int D>
+double Simulation<D>::criticalTimeStep() const {
+  const StepLimits limits = stepLimits();
+  double dt = limits.bodies;
+  for (const double own : limits.particle) dt = std::min(dt, own);
   return dt;
+}
+
+template <int D>
+double Simulation<D>::inertialMassRatio() const {
+  const auto& P = particles_;
+  double inertial = 0.0, physical = 0.0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
+    inertial += 1.0 / P.inv_mass[i];
+    physical += 1.0 / P.physical_inv_mass[i];
+  }
+  return physical > 0.0 ? inertial / physical : 1.0;
 }
 
 template <int D>
@@ -284,6 +307,8 @@ std::vector<StageTiming> Simulation<D>::stageTimings() const {
   template void Simulation<D>::fail(SimulationUnstable::Cause, const std::string&) const; \
   template std::string Simulation<D>::diagnose() const;                                   \
   template double Simulation<D>::criticalTimeStep() const;                                \
+  template double Simulation<D>::inertialMassRatio() const;                               \
+  template typename Simulation<D>::StepLimits Simulation<D>::stepLimits() const;          \
   template EnergyReport Simulation<D>::energy() const;                                    \
   template std::size_t Simulation<D>::particleContacts() const;                           \
   template double Simulation<D>::maxOverlapRatio() const;                                 \

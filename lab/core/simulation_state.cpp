@@ -119,6 +119,7 @@ void Simulation<D>::visit(Archive& ar) {
   ar("config.timestep.fixed_dt", config_.timestep.fixed_dt);
   ar("config.timestep.safety", config_.timestep.safety);
   ar("config.timestep.update_interval", config_.timestep.update_interval);
+  ar("config.timestep.density_scaling", config_.timestep.density_scaling);
   ar("config.guard.overlap_limit", config_.guard.overlap_limit);
   ar("config.guard.energy_growth", config_.guard.energy_growth);
   ar("config.guard.energy_runaway", config_.guard.energy_runaway);
@@ -152,7 +153,8 @@ void Simulation<D>::visit(Archive& ar) {
   ar("ledger.viscous", ledger_.viscous), ar("ledger.local_damping", ledger_.local_damping);
   ar("ledger.positive_input", ledger_.positive_input), ar("ledger.started", ledger_.started);
   ar("ledger.bond_breakage", ledger_.bond_breakage);
-  ar("ledger.clump_release", ledger_.clump_release);
+  ar("ledger.clump_release", ledger_.clump_release),
+      ar("ledger.mass_scaling", ledger_.mass_scaling);
   clumps_.visit(ar);
   ar("clump_breaks", clump_breaks_);
   ar("bond_kinds", bond_kinds_), ar("bonds", bonds_), ar("bond_breaks", bond_breaks_);

@@ -72,6 +72,7 @@ struct LoadingHistory {
   LoadingCurve curve;
   std::vector<std::size_t> breaks_at;
   std::vector<State> states;
+  AdaptiveRate rate;
   double meanUnbalanced() const {
     return unbalanced_sum / static_cast<double>(std::max<std::size_t>(1, curve.q.size()));
   }
@@ -83,7 +84,7 @@ struct LoadingHistory {
     ar("peak_strain", peak_strain), ar("peak_volumetric", peak_volumetric);
     ar("peak_axial", peak_axial), ar("confining_error", confining_error);
     ar("unbalanced_sum", unbalanced_sum), ar("inertial_max", inertial_max);
-    ar("curve", curve), ar("breaks_at", breaks_at), ar("states", states);
+    ar("curve", curve), ar("breaks_at", breaks_at), ar("states", states), ar("rate", rate);
   }
 };
 
@@ -114,6 +115,7 @@ LoadingHistory loadAxially(Specimen<D>& sp, const LoadingTest& test, double sigm
   const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
   const auto snapshot_every = static_cast<std::uint64_t>(sp.settings.output.snapshot_every_steps);
   LoadingHistory h;
+  h.rate = AdaptiveRate(test.boost);
   Journal::Unit unit = control.unit(n.stage);
   if (unit.done(h, sp)) return h;
   h.bond_breaks_before = sim.bondBreaks().size();
@@ -142,8 +144,10 @@ LoadingHistory loadAxially(Specimen<D>& sp, const LoadingTest& test, double sigm
         strain >= strain_max ||
         (test.stop_after_drop > 0.0 && h.peak > 0.0 && q < (1.0 - test.stop_after_drop) * h.peak &&
          strain > h.peak_strain && strain >= test.stop_after_drop_min_strain);
+    const double rate_now = rate * h.rate.factor();
     if (steps % record_every == 0 || done) {
-      recordState(sp, rec, n.prefix, n.stage, rate);
+      recordState(sp, rec, n.prefix, n.stage, rate_now);
+      rec.series(n.prefix + "axial_strain_rate_per_s", sim.steps(), sim.time(), rate_now);
       rec.series(n.prefix + "deviatoric_stress_MPa", sim.steps(), sim.time(), q / 1e6);
       h.curve.axial_strain.push_back(strain);
       h.curve.q.push_back(q);
@@ -157,7 +161,13 @@ LoadingHistory loadAxially(Specimen<D>& sp, const LoadingTest& test, double sigm
             std::max(h.confining_error, std::abs(frame.stress(a) - sigma3) / error_scale);
       }
       h.unbalanced_sum += sim.unbalancedForceRatio();
-      h.inertial_max = std::max(h.inertial_max, inertialNumber(sp, rate));
+      h.inertial_max = std::max(h.inertial_max, inertialNumber(sp, rate_now));
+    }
+    if (test.boost.max > 1.0 && steps % AdaptiveRate::kWindowSteps == 0) {
+      const std::size_t breaks = sim.bondBreaks().size() + sim.clumpBreaks().size();
+      const double before = h.rate.factor();
+      const double factor = h.rate.update(breaks, sim.unbalancedForceRatio());
+      if (factor != before) frame.set(ax, Axis{Mode::StrainRate, rate * factor});
     }
     if (snapshot_every > 0 && steps % snapshot_every == 0) {
       snapshot(sp, rec, n.stage, "step " + std::to_string(steps));

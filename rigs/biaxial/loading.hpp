@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "rigs/common/adaptive_rate.hpp"
 #include "rigs/common/envelope.hpp"
 #include "rigs/common/loading_keys.hpp"
 #include "rigs/common/specimen.hpp"
@@ -20,6 +21,7 @@ struct LoadingTest {
   double axial_strain_max = 0.05;
   double stop_after_drop = 0.0;
   double stop_after_drop_min_strain = 0.002;
+  RateBoost boost;  // rigs/common/adaptive_rate.hpp
 
   template <class F>
   void fields(F& f) {
@@ -36,6 +38,7 @@ struct LoadingTest {
       {"stop_after_drop_min_strain", units::none, Range::closed(0, 0.9),
        "the drop stops the test only past this axial strain: the first grains to break or "
        "slip under a barely loaded sample make no peak"});
+    boost.fields(f);
   }
   // A test that stops after the peak must get past it: a drop needs room to show.
   void validate() const;

@@ -13,6 +13,9 @@ const Outputs& outputs() {
           .prefixes({"confinement."})
           .series({
               {"deviatoric_stress_MPa", "MPa", "q: axial minus mean lateral stress"},
+              {"axial_strain_rate_per_s", "1/s",
+               "the platens' strain rate (above the set one while loading.rate_boost_max > 1 "
+               "and the sample is calm)"},
               {"band_window_angle_deg", "deg",
                "the band in each post-critical strain window of a compactive test"},
               {"band_window_contrast", "-", "that band's count over a uniform cloud's"},

@@ -181,7 +181,8 @@ template <int D>
 double inertialNumber(const Specimen<D>& sp, double strain_rate) {
   const double p = std::abs(sp.frame->meanStress());
   if (!(p > 0.0)) return INFINITY;
-  const double density = sp.settings.material.grain.density;
+  // The density the forces accelerate: heavier under density scaling.
+  const double density = sp.settings.material.grain.density * sp.sim->inertialMassRatio();
   return std::abs(strain_rate) * 2.0 * sp.mean_radius * std::sqrt(density / p);
 }
 

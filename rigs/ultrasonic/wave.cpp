@@ -133,6 +133,7 @@ WaveResult measureWave(Simulation<D>& sim, const WaveSpec& spec) {
   // (the pulse shifts it), so nothing would subtract it.
   sim.setLocalDamping(0.0);
   sim.setBondBreakage(false);
+  sim.setDensityScaling(1.0);  // a wave travels at the speed the physical masses give
   for (std::size_t i = 0; i < sim.walls().size(); ++i) {
     Wall<D>& w = sim.wall(i);
     w.servo.enabled = false;

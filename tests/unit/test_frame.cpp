@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "lab/core/packing.hpp"
+#include "rigs/common/adaptive_rate.hpp"
 #include "rigs/common/frame.hpp"
 #include "tests/support.hpp"
 
@@ -107,6 +108,25 @@ TEST(LoadingFrame, StressControlHoldsATargetOnFreeParticles) {
   }
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(frame.stress(a), target[a], 0.01 * target[a]) << a;
   EXPECT_LT(frame.stressError(), 0.01);
+}
+
+// The adaptive loading rate: up by 1.25 per calm window to its cap, back to the set rate at
+// once on a break or out of balance.
+TEST(AdaptiveRate, FastWhileCalmTheSetRateWhileItBreaks) {
+  RateBoost boost;
+  boost.max = 3.0;
+  boost.calm_unbalanced = 0.01;
+  AdaptiveRate rate(boost);
+  EXPECT_EQ(rate.factor(), 1.0);
+  EXPECT_DOUBLE_EQ(rate.update(0, 0.001), 1.25);
+  EXPECT_DOUBLE_EQ(rate.update(0, 0.001), 1.5625);
+  for (int k = 0; k < 10; ++k) rate.update(0, 0.001);
+  EXPECT_EQ(rate.factor(), 3.0);
+  EXPECT_EQ(rate.update(2, 0.001), 1.0);   // two bonds broke in the window
+  EXPECT_EQ(rate.update(2, 0.001), 1.25);  // none since
+  EXPECT_EQ(rate.update(2, 0.02), 1.0);    // out of balance
+  AdaptiveRate off{RateBoost{}};
+  EXPECT_EQ(off.update(0, 0.0), 1.0);  // rate_boost_max = 1 keeps the set rate
 }
 
 }  // namespace
