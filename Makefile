@@ -107,7 +107,7 @@ GALLERY_DIR := build/gallery
 STUDY = $(ROCKLAB) study accuracy --threads 1 --quiet --lab $(GALLERY_DIR)/lab-$@.sqlite \
   --out $(GALLERY_DIR)/$@
 GALLERY := oedometer biaxial envelope hydrostatic permeameter ultrasonic density-scaling \
-  rate-boost
+  rate-boost fewer-steps
 .PHONY: $(GALLERY)
 gallery: $(GALLERY)
 	@echo "gallery: reports/gallery/{$(shell echo $(GALLERY) | tr ' ' ,)}.png"
@@ -142,6 +142,11 @@ density-scaling: build
 	$(gallery_png)
 rate-boost: build
 	$(STUDY) protocols/biaxial-ucs-quick.toml --vary loading.rate_boost_max=1,2,4 --seeds 5
+	$(gallery_png)
+# The two together, against the reference setting (both off): what the protocol's defaults are.
+fewer-steps: build
+	$(STUDY) protocols/biaxial-ucs-quick.toml --vary numerics.density_scaling=1,4 \
+	  --vary loading.rate_boost_max=1,2 --seeds 5
 	$(gallery_png)
 
 format:

@@ -24,6 +24,8 @@ HertzParams mix(const MaterialTable& m, std::uint16_t a, std::uint16_t b) {
   p.gstar = 1.0 / ((2.0 - A.poisson) / ga + (2.0 - B.poisson) / gb);
   p.mu = m.friction(a, b);
   p.damp = 2.0 * std::sqrt(5.0 / 6.0) * m.dampingRatio(a, b);
+  p.cn_per_am = p.damp * std::sqrt(2.0 * p.estar);
+  p.cs_per_am = p.damp * std::sqrt(8.0 * p.gstar);
   return p;
 }
 

@@ -19,6 +19,8 @@ struct HertzParams {
   double gstar = 0.0;  // Pa, G* = 1 / ((2-nu1)/G1 + (2-nu2)/G2)
   double mu = 0.0;
   double damp = 0.0;  // 2 sqrt(5/6) beta
+  // damp sqrt(2 E*) and damp sqrt(8 G*), mixed once: the dashpots are these times sqrt(a m*).
+  double cn_per_am = 0.0, cs_per_am = 0.0;
 };
 
 struct HertzLaw {
@@ -28,8 +30,8 @@ struct HertzLaw {
     LawState s{4.0 / 3.0 * p.estar * a * overlap, 2.0 * p.estar * a, 8.0 * p.gstar * a, 0.0, 0.0};
     if (p.damp != 0.0) {
       const double am = std::sqrt(a * mstar);
-      s.cn = p.damp * std::sqrt(2.0 * p.estar) * am;
-      s.cs = p.damp * std::sqrt(8.0 * p.gstar) * am;
+      s.cn = p.cn_per_am * am;
+      s.cs = p.cs_per_am * am;
     }
     return s;
   }

@@ -30,6 +30,7 @@ struct ContactPass {
   int threads;
   bool track_energy;
   double overlap_limit;  // overlap / smaller radius beyond which the guard trips
+  bool lanes;  // touching pairs four per AVX register where the law and CPU can (same bits)
 
   // Out: energy dissipated in contacts this step (J), and whether an overlap exceeded the
   // limit.

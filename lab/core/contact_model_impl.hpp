@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lab/core/contact_lanes.hpp"
 #include "lab/core/contact_model.hpp"
 
 namespace rocklab {
@@ -144,6 +145,77 @@ class ContactModelImpl final : public ContactModel<D> {
     torque[j] -= tj;
   }
 
+  // Touching pairs gathered for the lane pass, four at a time in pair order.
+  struct LaneGroup {
+    std::uint32_t is[4], js[4], ps[4];
+    const Params* params[4];
+    int n = 0;
+  };
+
+  bool lanesOn(const ContactPass<D>& pass) const {
+    return lanes::LaneLaw<Law>::value && pass.lanes && lanes::available();
+  }
+
+  // Pair p of row i (particle a) touches: the scalar path's test, so both paths take the same
+  // pairs. A pair out of reach loses its history.
+  static bool touches(const PairView& v, const RowParticle& a, std::uint32_t p, std::uint32_t j) {
+    const V d = v.pos[j] - a.x;
+    const double reach = a.r + v.radius[j];
+    if (d.squaredNorm() >= reach * reach) {
+      v.shear[p].setZero();
+      return false;
+    }
+    return true;
+  }
+
+  void add(LaneGroup& g, const PairView& v, const RowParticle& a, std::size_t i, std::uint32_t p,
+           std::uint32_t j) const {
+    g.is[g.n] = static_cast<std::uint32_t>(i);
+    g.js[g.n] = j;
+    g.ps[g.n] = p;
+    g.params[g.n] = &table_(a.material, v.material[j]);
+    ++g.n;
+  }
+
+  // The group's pairs in lanes, then each applied in order, with its dissipation, as
+  // interact() would have (a short group repeats its first pair in the empty lanes). Only
+  // called where lanesOn().
+  template <bool kEnergy, class Apply>
+  void flush(const PairView& v, LaneGroup& g, ContactDissipation& diss, bool& over,
+             Apply&& apply) const {
+    if constexpr (lanes::LaneLaw<Law>::value) lanePass<kEnergy>(v, g, diss, over, apply);
+  }
+
+  template <bool kEnergy, class Apply>
+  void lanePass(const PairView& v, LaneGroup& g, ContactDissipation& diss, bool& over,
+                Apply&& apply) const {
+    if (g.n == 0) return;
+    for (int k = g.n; k < 4; ++k) {
+      g.is[k] = g.is[0], g.js[k] = g.js[0], g.ps[k] = g.ps[0], g.params[k] = g.params[0];
+    }
+    lanes::ContactsOut out;
+    lanes::fourContacts<D, Law, kEnergy>(v, g.is, g.js, g.ps, g.params, g.n, out);
+    for (int k = 0; k < g.n; ++k) {
+      if constexpr (kEnergy) {
+        if ((out.sliding >> k) & 1) diss.friction -= out.friction[k];
+        diss.viscous += out.viscous[k];
+      }
+      over |= ((out.over >> k) & 1) != 0;
+      V f;
+      A ti, tj;
+      for (int c = 0; c < D; ++c) f[c] = out.force[c][k];
+      if constexpr (D == 3) {
+        ti = A(out.ti[0][k], out.ti[1][k], out.ti[2][k]);
+        tj = A(out.tj[0][k], out.tj[1][k], out.tj[2][k]);
+      } else {
+        ti = out.ti[0][k];
+        tj = out.tj[0][k];
+      }
+      apply(g.is[k], g.js[k], f, ti, tj);
+    }
+    g.n = 0;
+  }
+
   void storeBlock(std::size_t b, const ContactDissipation& diss, bool over) {
     buffers_.block_friction[b] = diss.friction;
     buffers_.block_viscous[b] = diss.viscous;
@@ -175,17 +247,34 @@ class ContactModelImpl final : public ContactModel<D> {
     const PairView v = viewOf(pass);
     V* force = P.force.data();
     A* torque = P.torque.data();
+    const bool lanes_on = lanesOn(pass);
     for (std::size_t b = 0; b < blocks; ++b) {
       ContactDissipation diss;
       bool over = false;  // not a uint8_t: a char store may alias anything
       const std::size_t i_end = std::min(n, (b + 1) * kBlockRows);
-      for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
-        const RowParticle a = rowParticle(v, i);
-        for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-          interact<kEnergy>(v, a, p, diss, over,
-                            [&](std::uint32_t j, const V& f, const A& ti, const A& tj) {
-                              scatter(force, torque, i, j, f, ti, tj);
-                            });
+      if (lanes_on) {
+        LaneGroup g;
+        const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti,
+                               const A& tj) { scatter(force, torque, i, j, f, ti, tj); };
+        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
+          const RowParticle a = rowParticle(v, i);
+          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+            const std::uint32_t j = v.col[p];
+            if (!touches(v, a, p, j)) continue;
+            add(g, v, a, i, p, j);
+            if (g.n == 4) flush<kEnergy>(v, g, diss, over, apply);
+          }
+        }
+        flush<kEnergy>(v, g, diss, over, apply);
+      } else {
+        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
+          const RowParticle a = rowParticle(v, i);
+          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+            interact<kEnergy>(v, a, p, diss, over,
+                              [&](std::uint32_t j, const V& f, const A& ti, const A& tj) {
+                                scatter(force, torque, i, j, f, ti, tj);
+                              });
+          }
         }
       }
       storeBlock(b, diss, over);
@@ -235,6 +324,7 @@ class ContactModelImpl final : public ContactModel<D> {
     const PairView v = viewOf(pass);
     V* force = P.force.data();
     A* torque = P.torque.data();
+    const bool lanes_on = lanesOn(pass);
 
 #pragma omp parallel num_threads(threads)
     {
@@ -304,12 +394,17 @@ class ContactModelImpl final : public ContactModel<D> {
         ContactDissipation diss;
         bool over = false;
         std::uint32_t touching = 0;
+        LaneGroup group;
+        const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti,
+                               const A& tj) { scatter(force, torque, i, j, f, ti, tj); };
         const std::size_t i_end = std::min(hi, (b + 1) * kBlockRows);
         for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
           const RowParticle a = rowParticle(v, i);
           for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
             const std::uint32_t j = col[p];
             if (j >= hi) {
+              // The pending pairs come first in pair order: theirs before this one's share.
+              flush<kEnergy>(v, group, diss, over, apply);
               const KeptContact<D>& kept = B.cross_result[g++];
               if (!kept.touching) continue;
               if constexpr (kEnergy) {
@@ -320,12 +415,20 @@ class ContactModelImpl final : public ContactModel<D> {
               torque[i] -= kept.f.torque_i;
               continue;
             }
+            if (lanes_on) {
+              if (!touches(v, a, p, j)) continue;
+              ++touching;
+              add(group, v, a, i, p, j);
+              if (group.n == 4) flush<kEnergy>(v, group, diss, over, apply);
+              continue;
+            }
             touching += interact<kEnergy>(v, a, p, diss, over,
                                           [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
                                             scatter(force, torque, i, j, f, ti, tj);
                                           });
           }
         }
+        flush<kEnergy>(v, group, diss, over, apply);
         storeBlock(b, diss, over);
         B.block_touching[b] = touching;
       }

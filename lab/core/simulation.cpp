@@ -220,7 +220,8 @@ bool Simulation<D>::computeForces(double history_dt) {
                       threaded(),
                       config_.threads,
                       config_.track_energy,
-                      config_.guard.overlap_limit};
+                      config_.guard.overlap_limit,
+                      config_.contact_lanes};
   {
     const StageClock clock(&stages_[kContacts]);
     model_->computeForces(pass);

@@ -72,6 +72,9 @@ struct SimulationConfig {
   // false: bonds one at a time. The four-lane pass (bond_lanes.hpp, 2D and 3D) gives the same bits,
   // so this only changes the speed; the tests compare the two.
   bool bond_lanes = true;
+  // false: touching pairs one at a time; the four-lane pass (contact_lanes.hpp) gives the same
+  // bits, as for bonds.
+  bool contact_lanes = true;
 
   // The fields a protocol sets, with their keys (the contact law in the material section).
   template <class F>

@@ -52,7 +52,20 @@ TEST(Determinism, TwoDimensionalPackingIsTheSameOnOneAndTwoThreads) {
   }
 }
 
-std::uint64_t compressedHash(int threads, int dim_steps) {
+// The bits of a run: its state and the dissipation the contacts booked.
+struct RunBits {
+  std::uint64_t hash = 0;
+  double friction = 0.0, viscous = 0.0;
+  friend bool operator==(const RunBits&, const RunBits&) = default;
+};
+
+template <int D>
+RunBits bitsOf(const Simulation<D>& sim) {
+  const EnergyLedger& l = sim.energy().ledger;
+  return {sim.stateHash(), l.friction, l.viscous};
+}
+
+RunBits compressed(int threads, int dim_steps, bool contact_lanes) {
   PackingSpec spec;
   spec.count = 2500;
   spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
@@ -63,6 +76,7 @@ std::uint64_t compressedHash(int threads, int dim_steps) {
   cfg.contact_law = "hertz";
   cfg.local_damping = 0.2;
   cfg.threads = threads;
+  cfg.contact_lanes = contact_lanes;
   cfg.gravity = {0, 0, -9.81};
   Simulation<3> sim(testing::table(testing::hertzMaterial(5e8, 0.25, 0.5, 0.1)), cfg);
   for (std::size_t i = 0; i < p.centers.size(); ++i) {
@@ -72,18 +86,31 @@ std::uint64_t compressedHash(int threads, int dim_steps) {
   for (int w = 0; w < 6; ++w) sim.wall(w).velocity = 0.05 * sim.wall(w).normal;
   sim.run(dim_steps);
   EXPECT_GT(sim.contacts().rebuilds, 1u);
-  return sim.stateHash();
+  return bitsOf(sim);
 }
 
 TEST(Determinism, CompressionIsTheSameOnOneAndTwoThreads) {
   ASSERT_GE(omp_get_num_procs(), 1);
-  EXPECT_EQ(compressedHash(1, 3000), compressedHash(2, 3000));
+  EXPECT_EQ(compressed(1, 3000, true), compressed(2, 3000, true));
+}
+
+// The contact pass four pairs per AVX register (contact_lanes.hpp) gives the scalar pass's
+// bits: Hertz spheres squeezed by the walls under gravity, damped, some contacts sliding and
+// some sticking, on one and two threads (the threaded pass interleaves the lanes with the
+// pairs other threads computed).
+TEST(Determinism, HertzContactsInLanesAreTheScalarBits) {
+  const RunBits scalar = compressed(1, 3000, false);
+  EXPECT_EQ(compressed(1, 3000, true), scalar);
+  EXPECT_EQ(compressed(2, 3000, true), scalar);
+  EXPECT_GT(scalar.friction, 0.0);  // contacts slid
+  EXPECT_GT(scalar.viscous, 0.0);
 }
 
 // Cemented rock crushed by a wall: bonds break during the run (two-phase removal) and the
-// state is still the same bits on one and two threads, and with the bonds computed one at a
-// time or four per AVX register (bond_lanes.hpp; the bonds start unloaded, hold gaps and
-// break, so every masked branch of the lanes is taken).
+// state is still the same bits on one and two threads, and with the bonds and the linear
+// contacts (stiffness from a modulus, damped) computed one at a time or four per AVX register
+// (bond_lanes.hpp, contact_lanes.hpp; the bonds start unloaded, hold gaps and break, so every
+// masked branch of the lanes is taken).
 TEST(Determinism, BondBreaksAreTheSameOnOneAndTwoThreadsAndInLanes) {
   PackingSpec spec;
   spec.count = 2000;
@@ -96,6 +123,7 @@ TEST(Determinism, BondBreaksAreTheSameOnOneAndTwoThreadsAndInLanes) {
     cfg.local_damping = 0.2;
     cfg.threads = threads;
     cfg.bond_lanes = lanes;
+    cfg.contact_lanes = lanes;
     Material m = testing::linearMaterial(0.0, 0.0, 0.5, 0.05);
     m.modulus = 1e8;
     Simulation<3> sim(testing::table(m), cfg);
@@ -123,27 +151,37 @@ TEST(Determinism, BondBreaksAreTheSameOnOneAndTwoThreadsAndInLanes) {
   EXPECT_GT(b1, 50u);
 }
 
-TEST(Determinism, DisksAreTheSameOnOneAndTwoThreads) {
-  auto hash = [](int threads) {
-    PackingSpec spec;
-    spec.count = 4000;
-    spec.sizes = SizeDistribution::normal(2e-3, 0.4e-3, 1e-3, 3e-3);
-    spec.porosity = 0.2;
-    spec.threads = threads;
-    const auto p = generatePacking<2>(spec);
-    SimulationConfig cfg;
-    cfg.local_damping = 0.1;
-    cfg.threads = threads;
-    Simulation<2> sim(testing::table(testing::linearMaterial(1e7, 5e6, 0.5, 0.1)), cfg);
-    for (std::size_t i = 0; i < p.centers.size(); ++i) {
-      testing::addParticle<2>(sim, p.centers[i], p.radii[i], Eigen::Vector2d::Zero());
-    }
-    testing::addBox<2>(sim, p.lo, p.hi);
-    for (int w = 0; w < 4; ++w) sim.wall(w).velocity = 0.05 * sim.wall(w).normal;
-    sim.run(3000);
-    return sim.stateHash();
-  };
-  EXPECT_EQ(hash(1), hash(2));
+// Damped linear disks squeezed by the walls, with and without the energy bookkeeping (two
+// instances of each pass), one and two threads, the contacts in lanes or one at a time.
+RunBits squeezedDisks(int threads, bool contact_lanes, bool track_energy) {
+  PackingSpec spec;
+  spec.count = 4000;
+  spec.sizes = SizeDistribution::normal(2e-3, 0.4e-3, 1e-3, 3e-3);
+  spec.porosity = 0.2;
+  spec.threads = threads;
+  const auto p = generatePacking<2>(spec);
+  SimulationConfig cfg;
+  cfg.local_damping = 0.1;
+  cfg.threads = threads;
+  cfg.contact_lanes = contact_lanes;
+  cfg.track_energy = track_energy;
+  Simulation<2> sim(testing::table(testing::linearMaterial(1e7, 5e6, 0.5, 0.1)), cfg);
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    testing::addParticle<2>(sim, p.centers[i], p.radii[i], Eigen::Vector2d::Zero());
+  }
+  testing::addBox<2>(sim, p.lo, p.hi);
+  for (int w = 0; w < 4; ++w) sim.wall(w).velocity = 0.05 * sim.wall(w).normal;
+  sim.run(3000);
+  return bitsOf(sim);
+}
+
+TEST(Determinism, DisksInLanesAreTheScalarBitsOnOneAndTwoThreads) {
+  const RunBits scalar = squeezedDisks(1, false, true);
+  EXPECT_EQ(squeezedDisks(1, true, true), scalar);
+  EXPECT_EQ(squeezedDisks(2, true, true), scalar);
+  EXPECT_GT(scalar.friction, 0.0);
+  EXPECT_GT(scalar.viscous, 0.0);
+  EXPECT_EQ(squeezedDisks(2, true, false).hash, squeezedDisks(1, false, false).hash);
 }
 
 }  // namespace
