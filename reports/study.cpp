@@ -92,6 +92,26 @@ Figure costAccuracyChart(const Study& s) {
   }
   p.series = {all, front, tol};
   f.panels = {p};
+  if (!seeds) return f;
+  // The second panel: what a mean of the same precision costs. A setting may keep the
+  // means and still widen the seeds' scatter (a new draw of the sample per seed).
+  f.caption +=
+      " Below: the largest ratio of a key result's standard deviation over the seeds "
+      "to the finest setting's; a mean as precise as the finest's needs its square "
+      "times the seeds.";
+  Panel q{"wall time (s)", "largest seed scatter / the finest's", {}};
+  Series ratio{"settings", {}, {}, true}, one{"as the finest", {}, {}, false};
+  for (const StudyPoint& point : s.points) {
+    if (!std::isfinite(point.scatter)) continue;
+    ratio.x.push_back(point.wall_seconds), ratio.y.push_back(point.scatter);
+  }
+  if (!ratio.x.empty()) {
+    one.x = {*std::min_element(ratio.x.begin(), ratio.x.end()),
+             *std::max_element(ratio.x.begin(), ratio.x.end())};
+    one.y = {1.0, 1.0};
+  }
+  q.series = {ratio, one};
+  f.panels.push_back(q);
   return f;
 }
 
@@ -174,6 +194,10 @@ Study evaluateStudy(const std::string& lab, const std::vector<std::int64_t>& ids
         const campaign::Difference diff = campaign::compareMeans(finest, mine);
         inside = summaries.size() > 1 && diff.known && !diff.resolved();
       }
+      if (mine.n > 1 && finest.n > 1 && finest.std > 0.0) {
+        q.scatter = std::isnan(q.scatter) ? mine.std / finest.std
+                                          : std::max(q.scatter, mine.std / finest.std);
+      }
       q.deviation.push_back(dev);
       q.within_scatter.push_back(inside);
       q.error = dev ? std::max(q.error, *dev) : INFINITY;
@@ -210,6 +234,7 @@ std::string studySummary(const Study& s) {
     << " s for the finest, largest deviation " << 100.0 * c.error << "%";
   if (s.seeds > 1) {
     o << ", " << 100.0 * c.loss << "% beyond the scatter of " << s.seeds << " seeds";
+    if (std::isfinite(c.scatter)) o << ", seed scatter " << c.scatter << " times the finest's";
   }
   return o.str();
 }
@@ -225,7 +250,7 @@ std::string runIds(const StudyPoint& q) {
 void writeStudyCsv(const Study& s, const std::string& path) {
   std::ofstream csv(path);
   csv.precision(10);
-  csv << "runs,setting,status,wall_seconds,error,loss,pareto";
+  csv << "runs,setting,status,wall_seconds,error,loss,scatter_ratio,pareto";
   for (const std::string& k : s.key_names) {
     csv << "," << k << "," << k << "_std," << k << "_deviation," << k << "_within_scatter";
   }
@@ -234,7 +259,9 @@ void writeStudyCsv(const Study& s, const std::string& path) {
     std::string setting = q.setting;
     std::replace(setting.begin(), setting.end(), ',', ';');
     csv << runIds(q) << "," << setting << "," << q.status << "," << q.wall_seconds << "," << q.error
-        << "," << q.loss << "," << q.pareto;
+        << "," << q.loss << ",";
+    if (std::isfinite(q.scatter)) csv << q.scatter;
+    csv << "," << q.pareto;
     for (std::size_t k = 0; k < s.key_names.size(); ++k) {
       csv << ",";
       if (q.values[k]) csv << *q.values[k];
@@ -285,13 +312,15 @@ void writeStudyReport(const Study& s, const std::string& out) {
     << num(s.points.front().wall_seconds / std::max(c.wall_seconds, 1e-9), 3)
     << "&times; faster), largest deviation " << percent(c.error);
   if (seeds) b << ", " << percent(c.loss) << " beyond the seed scatter";
+  if (std::isfinite(c.scatter))
+    b << ", seed scatter " << num(c.scatter, 3) << " times the finest's";
   b << ".</p>\n";
   b << "<figure><img src=\"cost-accuracy.png\" alt=\"cost-accuracy chart\"><figcaption>"
     << html(chart.caption) << " Data: <a href=\"cost-accuracy.csv\">cost-accuracy.csv</a>, "
     << "<a href=\"study.csv\">study.csv</a>.</figcaption></figure>\n";
   b << "<h2>Settings</h2>\n<table><tr><th>run" << (seeds ? "s" : "")
     << "</th><th>setting</th><th>status</th><th>wall time (s)</th><th>error</th>"
-    << (seeds ? "<th>loss</th>" : "") << "<th>Pareto</th>";
+    << (seeds ? "<th>loss</th><th>scatter / finest's</th>" : "") << "<th>Pareto</th>";
   for (std::size_t k = 0; k < s.key_names.size(); ++k) {
     b << "<th>" << html(s.key_names[k])
       << (s.key_units[k].empty() || s.key_units[k] == "-" ? "" : " (" + html(s.key_units[k]) + ")")
@@ -302,8 +331,10 @@ void writeStudyReport(const Study& s, const std::string& out) {
     b << "<tr><td>" << runIds(q) << "</td><td>" << html(q.setting) << "</td><td class=\"status-"
       << q.status << "\">" << q.status << "</td><td class=\"n\">" << num(q.wall_seconds, 4)
       << "</td><td class=\"n\">" << percent(q.error) << "</td>"
-      << (seeds ? "<td class=\"n\">" + percent(q.loss) + "</td>" : "") << "<td>"
-      << (q.pareto ? "yes" : "") << "</td>";
+      << (seeds ? "<td class=\"n\">" + percent(q.loss) + "</td><td class=\"n\">" +
+                      (std::isfinite(q.scatter) ? num(q.scatter, 3) : "&ndash;") + "</td>"
+                : "")
+      << "<td>" << (q.pareto ? "yes" : "") << "</td>";
     for (std::size_t k = 0; k < s.key_names.size(); ++k) {
       b << "<td class=\"n\">" << (q.values[k] ? num(*q.values[k], 4) : "&ndash;");
       if (q.spread[k]) b << " &plusmn; " << num(*q.spread[k], 2);

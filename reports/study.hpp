@@ -4,6 +4,7 @@
 // study's report: the cost-accuracy chart with its Pareto front, the table, and the cheapest
 // setting within the user's tolerance.
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -28,6 +29,10 @@ struct StudyPoint {
   // The largest deviation beyond the seed scatter: the accuracy the setting loses (with one
   // seed, the error).
   double loss = 0.0;
+  // The largest ratio of a key result's seed scatter (standard deviation) to the finest
+  // setting's: a setting that widens it needs ratio^2 times the seeds for a mean as precise
+  // (NaN with one seed).
+  double scatter = NAN;
   bool pareto = false;  // no faster setting loses as little
 };
 

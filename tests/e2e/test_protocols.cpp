@@ -104,7 +104,7 @@ lateral_stress_MPa = 5
 )";
 
 // Li & Holt section 2.3: the superparticle sample's UCS is 9.9 MPa (calibrated: measured
-// 9.77 MPa on the quick sample; +-25% allows for another seed of 250 grains).
+// 9.80 MPa on the quick sample; +-25% allows for another seed of 250 grains).
 TEST(QuickProtocols, SuperparticleSampleHasThePapersUcs) {
   Lab lab("ucs");
   nb::Notebook n = runQuick(lab, "biaxial-ucs-quick");

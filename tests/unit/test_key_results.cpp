@@ -254,6 +254,9 @@ TEST(AccuracyStudy, ADeviationInsideTheSeedScatterIsNoLoss) {
   EXPECT_FALSE(s.points[2].within_scatter[0]);
   EXPECT_NEAR(s.points[2].loss, 0.2, 1e-9);
   EXPECT_EQ(s.cheapest, 1);
+  // Standard deviations 0.751 and 1 against the finest's 1.
+  EXPECT_NEAR(s.points[1].scatter, std::sqrt(1.1267 / 2.0), 1e-4);
+  EXPECT_DOUBLE_EQ(s.points[2].scatter, 1.0);
   const std::string out = lab + ".report";
   writeStudyReport(s, out);
   std::ifstream in(out + "/index.html");
