@@ -183,12 +183,25 @@ class ContactModelImpl final : public ContactModel<D> {
   template <bool kEnergy, class Apply>
   void flush(const PairView& v, LaneGroup& g, ContactDissipation& diss, bool& over,
              Apply&& apply) const {
-    if constexpr (lanes::LaneLaw<Law>::value) lanePass<kEnergy>(v, g, diss, over, apply);
+    if constexpr (lanes::LaneLaw<Law>::value) {
+      lanePass<kEnergy>(
+          v, g, [&](int) -> ContactDissipation& { return diss; }, over,
+          [&](int, std::uint32_t i, std::uint32_t j, const V& f, const A& ti, const A& tj) {
+            apply(i, j, f, ti, tj);
+          });
+    }
   }
 
-  template <bool kEnergy, class Apply>
-  void lanePass(const PairView& v, LaneGroup& g, ContactDissipation& diss, bool& over,
-                Apply&& apply) const {
+  // The same for pairs kept apart (the threaded pass's cross pairs): lane k's dissipation
+  // goes to dissOf(k) and its force to apply(k, ...).
+  template <bool kEnergy, class DissOf, class Apply>
+  void flushEach(const PairView& v, LaneGroup& g, DissOf&& dissOf, bool& over,
+                 Apply&& apply) const {
+    if constexpr (lanes::LaneLaw<Law>::value) lanePass<kEnergy>(v, g, dissOf, over, apply);
+  }
+
+  template <bool kEnergy, class DissOf, class Apply>
+  void lanePass(const PairView& v, LaneGroup& g, DissOf&& dissOf, bool& over, Apply&& apply) const {
     if (g.n == 0) return;
     for (int k = g.n; k < 4; ++k) {
       g.is[k] = g.is[0], g.js[k] = g.js[0], g.ps[k] = g.ps[0], g.params[k] = g.params[0];
@@ -197,6 +210,7 @@ class ContactModelImpl final : public ContactModel<D> {
     lanes::fourContacts<D, Law, kEnergy>(v, g.is, g.js, g.ps, g.params, g.n, out);
     for (int k = 0; k < g.n; ++k) {
       if constexpr (kEnergy) {
+        ContactDissipation& diss = dissOf(k);
         if ((out.sliding >> k) & 1) diss.friction -= out.friction[k];
         diss.viscous += out.viscous[k];
       }
@@ -211,7 +225,7 @@ class ContactModelImpl final : public ContactModel<D> {
         ti = out.ti[0][k];
         tj = out.tj[0][k];
       }
-      apply(g.is[k], g.js[k], f, ti, tj);
+      apply(k, g.is[k], g.js[k], f, ti, tj);
     }
     g.n = 0;
   }
@@ -357,21 +371,49 @@ class ContactModelImpl final : public ContactModel<D> {
         B.cross_start[threads] = B.cross.size();
         B.cross_result.resize(B.cross.size());
       }
-      // The cross pairs first, shared out evenly (the runs' boundaries hold most of them).
+      // The cross pairs first, shared out evenly (the runs' boundaries hold most of them),
+      // the touching ones four per register like the rows' (a pair's result does not depend
+      // on the pairs it shares the register with).
       bool cross_over = false;
-#pragma omp for schedule(static)
-      for (std::size_t g = 0; g < B.cross.size(); ++g) {
-        KeptContact<D>& c = B.cross_result[g];
-        c.diss = {};
-        const RowParticle a = rowParticle(v, B.cross_row[g]);
-        c.touching = interact<kEnergy>(v, a, B.cross[g], c.diss, cross_over,
-                                       [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
-                                         c.f.force = f;
-                                         c.f.torque_i = ti;
-                                         c.f.torque_j = tj;
-                                       });
+      {
+        const std::size_t m = B.cross.size();
+        const std::size_t first = m * t / threads, last = m * (t + 1) / threads;
+        LaneGroup group;
+        std::size_t slot[4];  // the group's pairs in cross_result
+        const auto dissOf = [&](int k) -> ContactDissipation& {
+          return B.cross_result[slot[k]].diss;
+        };
+        const auto keep = [&](int k, std::uint32_t, std::uint32_t, const V& f, const A& ti,
+                              const A& tj) {
+          KeptContact<D>& c = B.cross_result[slot[k]];
+          c.f.force = f;
+          c.f.torque_i = ti;
+          c.f.torque_j = tj;
+        };
+        for (std::size_t g = first; g < last; ++g) {
+          KeptContact<D>& c = B.cross_result[g];
+          c.diss = {};
+          const std::uint32_t i = B.cross_row[g], p = B.cross[g];
+          const RowParticle a = rowParticle(v, i);
+          if (lanes_on) {
+            c.touching = touches(v, a, p, col[p]);
+            if (!c.touching) continue;
+            slot[group.n] = g;
+            add(group, v, a, i, p, col[p]);
+            if (group.n == 4) flushEach<kEnergy>(v, group, dissOf, cross_over, keep);
+            continue;
+          }
+          c.touching = interact<kEnergy>(v, a, p, c.diss, cross_over,
+                                         [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
+                                           c.f.force = f;
+                                           c.f.torque_i = ti;
+                                           c.f.torque_j = tj;
+                                         });
+        }
+        flushEach<kEnergy>(v, group, dissOf, cross_over, keep);
       }
       B.thread_over[t] = cross_over;
+#pragma omp barrier  // every cross pair is ready before the partners' shares are read
 
       // The partners' shares of lower threads' cross pairs come first ...
       const std::uint32_t first_pair = row[lo];
