@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """Time to result: the quick protocols with an old and a new rocklab, alternating (issue 27).
 
-  tests/bench_protocols.py --old OLD/rocklab [--new build/release/rocklab]
+  tests/bench_protocols.py --old OLD/rocklab [--old-source OLD] [--new build/release/rocklab]
                            [--protocols hydrostatic-quick,biaxial-ucs-quick,...]
                            [--repeat 3] [--threads 2] [--out build/bench-protocols]
 
 Each protocol (default: every protocols/*-quick.toml) runs --repeat times with each binary,
 the two alternating (old first, then new first, and so on, so that a drift of the machine
-weighs on both), each run into a fresh notebook. Printed per protocol: the median wall time
+weighs on both), each run into a fresh notebook. The old binary runs the protocol file of --old-source (its
+source tree) when given: a protocol whose defaults moved to new keys runs as it was, which
+is what a user of the old binary waited for. Printed per protocol: the median wall time
 of each binary (the process's, what a user waits for), their ratio old / new, and each key
 result of the new binary's last run against the seed scatter of the protocol's regression
 reference (tests/reference/<protocol>.toml holds its values at three seeds): inside when it
@@ -15,8 +17,9 @@ lies in the 95% prediction interval of one more seed, mean +- t(0.975, n - 1) s 
 A result the reference does not guard is listed as such.
 
 Build the old binary from the commit to compare with, for example
-  git worktree add /tmp/old main && cmake -S /tmp/old -B /tmp/old/build -G Ninja
+  git worktree add /tmp/old 7434d0b && cmake -S /tmp/old -B /tmp/old/build -G Ninja
   -DCMAKE_BUILD_TYPE=Release -DROCKLAB_TESTS=OFF && ninja -C /tmp/old/build rocklab
+  tests/bench_protocols.py --old /tmp/old/build/rocklab --old-source /tmp/old
 A benchmark, not a test: it asserts nothing. Do not load the machine while it runs.
 """
 import argparse
@@ -112,6 +115,8 @@ def reference_of(protocol_name):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--old", required=True, help="the rocklab binary to compare with")
+    ap.add_argument("--old-source", default=SOURCE,
+                    help="source tree whose protocols/ the old binary runs")
     ap.add_argument("--new", default=os.path.join(SOURCE, "build", "release", "rocklab"))
     ap.add_argument("--protocols", default="",
                     help="comma-separated protocol names (default: every quick protocol)")
@@ -127,14 +132,15 @@ def main():
                        for p in glob.glob(os.path.join(SOURCE, "protocols", "*-quick.toml")))
     ratios = []
     for name in names:
-        protocol = os.path.join(SOURCE, "protocols", name + ".toml")
+        protocol = {"old": os.path.join(a.old_source, "protocols", name + ".toml"),
+                    "new": os.path.join(SOURCE, "protocols", name + ".toml")}
         times = {"old": [], "new": []}
         for k in range(a.repeat):
             order = ["old", "new"] if k % 2 == 0 else ["new", "old"]
             for which in order:
                 binary = a.old if which == "old" else a.new
                 lab = os.path.join(a.out, "%s-%s.sqlite" % (name, which))
-                times[which].append(timed_run(binary, protocol, a.threads, lab))
+                times[which].append(timed_run(binary, protocol[which], a.threads, lab))
         old, new = statistics.median(times["old"]), statistics.median(times["new"])
         ratios.append(old / new)
         print("%s: old %.1f s, new %.1f s (medians of %d, %d threads): %.2fx"
