@@ -24,6 +24,10 @@ void Settings::validate() const {
     if (k > 0 && at[k] <= at[k - 1])
       throw InvalidParameter("", cycles, "cycle strains must increase");
   }
+  if (boost.max > 1.0 && control != Control::StrainRate) {
+    throw InvalidParameter("", "loading.rate_boost_max",
+                           "the rate boost needs loading.control = strain_rate");
+  }
   if (coring && coring_unload_to >= specimen.formation.lateral_stress) {
     throw InvalidParameter("", "coring.unload_to_MPa",
                            "coring must unload below the formation stresses");
@@ -73,13 +77,14 @@ struct OedometricHistory {
   std::uint64_t steps = 0;
   double unbalanced_sum = 0.0, inertial_max = 0.0;
   std::size_t loading_records = 0;
+  AdaptiveRate rate;
   double meanUnbalanced() const { return loading_records ? unbalanced_sum / loading_records : 0.0; }
   // The loop's state in a checkpoint (rigs/common/journal.hpp).
   template <class Archive>
   void visit(Archive& ar) {
     ar("pts", pts), ar("cycles", cycles), ar("next_cycle", next_cycle), ar("phase", phase);
     ar("steps", steps), ar("unbalanced_sum", unbalanced_sum), ar("inertial_max", inertial_max);
-    ar("loading_records", loading_records);
+    ar("loading_records", loading_records), ar("rate", rate);
   }
 };
 
@@ -103,6 +108,7 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
   const auto snapshot_every = static_cast<std::uint64_t>(sp.settings.output.snapshot_every_steps);
 
   OedometricHistory h;
+  h.rate = AdaptiveRate(s.boost);
   Journal::Unit unit = control.unit(stage);
   if (unit.done(h, sp)) return h;
   for (int a = 0; a < D; ++a) {
@@ -126,10 +132,15 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
     }
     return l;
   };
+  // The axial strain rate now: the set one, times the boost while the sample is calm, down
+  // while a cycle unloads.
+  auto rateNow = [&] { return (phase == 1 ? -rate : rate) * h.rate.factor(); };
   auto record = [&] {
-    const double edot = phase == 1 ? -rate : rate;
+    const double edot = rateNow();
     recordState(sp, rec, prefix, stage, strain_control ? edot : 0.0);
     rec.series(prefix + "phase", sim.steps(), sim.time(), phase);
+    if (strain_control)
+      rec.series(prefix + "axial_strain_rate_per_s", sim.steps(), sim.time(), edot);
     h.pts.push_back(
         {frame.strain(ax), frame.stress(ax), lateral(),
          static_cast<double>(sp.broken(BondBreakMode::Tensile) + sp.broken(BondBreakMode::Shear)),
@@ -137,7 +148,9 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
     if (phase == 0) {
       h.unbalanced_sum += sim.unbalancedForceRatio();
       ++h.loading_records;
-      if (strain_control) h.inertial_max = std::max(h.inertial_max, inertialNumber(sp, rate));
+      if (strain_control) {
+        h.inertial_max = std::max(h.inertial_max, inertialNumber(sp, std::abs(edot)));
+      }
     }
   };
   record();
@@ -152,7 +165,7 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
       record();
       cycles.push_back({cycle_at[next_cycle], stress, strain, 0, 0});
       phase = 1;
-      frame.set(ax, Axis{Mode::StrainRate, -rate});
+      frame.set(ax, Axis{Mode::StrainRate, rateNow()});
     } else if (phase == 1 &&
                stress <= cycles.back().peak_stress -
                              s.cycle_unload_fraction * (cycles.back().peak_stress - sigma0)) {
@@ -160,7 +173,7 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
       cycles.back().low_stress = stress;
       cycles.back().low_strain = strain;
       phase = 2;
-      frame.set(ax, Axis{Mode::StrainRate, rate});
+      frame.set(ax, Axis{Mode::StrainRate, rateNow()});
     } else if (phase == 2 && strain >= cycles.back().peak_strain) {
       record();
       phase = 0;
@@ -173,6 +186,13 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
       break;
     }
     if ((sim.steps() - start) % record_every == 0) record();
+    if (s.boost.max > 1.0 && (sim.steps() - start) % AdaptiveRate::kWindowSteps == 0) {
+      const std::size_t breaks = sim.bondBreaks().size() + sim.clumpBreaks().size();
+      const double before = h.rate.factor();
+      if (h.rate.update(breaks, sim.unbalancedForceRatio()) != before) {
+        frame.set(ax, Axis{Mode::StrainRate, rateNow()});
+      }
+    }
     if (snapshot_every && (sim.steps() - start) % snapshot_every == 0) {
       snapshot(sp, rec, stage, "step " + std::to_string(sim.steps() - start));
     }

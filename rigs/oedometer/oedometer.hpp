@@ -7,6 +7,7 @@
 
 #include <vector>
 
+#include "rigs/common/adaptive_rate.hpp"
 #include "rigs/common/loading_keys.hpp"
 #include "rigs/common/outputs.hpp"
 #include "rigs/common/specimen.hpp"
@@ -27,6 +28,7 @@ struct Settings {
   bool coring = false;
   double coring_unload_to = 0.5 * kMPa;    // Pa
   double coring_stress_rate = 2e4 * kMPa;  // Pa/s
+  RateBoost boost;                         // rigs/common/adaptive_rate.hpp (strain control)
 
   template <class F>
   void fields(F& f) {
@@ -54,6 +56,7 @@ struct Settings {
             {"cycle_unload_fraction", units::none, Range::leftOpen(0, 1),
              "each cycle unloads this fraction of the axial stress gained since formation "
              "(below 1: a cycle never unloads past the formation state, which would core)"});
+    boost.fields(loading);
     auto core = f.at("coring.");
     core(coring, {"enabled",
                   units::text,

@@ -9,7 +9,11 @@ const Outputs& outputs() {
       Outputs()
           .add(specimenOutputs())
           .prefixes({"virgin.", "cored.", "coring.", "reloading."})
-          .series({{"phase", "-", "0 loading, 1 unloading, 2 reloading of a cycle"}})
+          .series({{"phase", "-", "0 loading, 1 unloading, 2 reloading of a cycle"},
+                   {"axial_strain_rate_per_s", "1/s",
+                    "the axial walls' strain rate under strain control (above the set one "
+                    "while loading.rate_boost_max > 1 and the sample is calm; negative "
+                    "while a cycle unloads)"}})
           .results({
               {"tangent_modulus_initial_MPa", "MPa", "oedometric tangent modulus at the start"},
               {"tangent_modulus_final_MPa", "MPa", "oedometric tangent modulus at the end"},

@@ -256,6 +256,45 @@ TEST(Protocols, FastLoadingIsFlaggedAsNotQuasiStatic) {
   std::filesystem::remove(file);
 }
 
+// The oedometer's adaptive rate: up to rate_boost_max times the set rate while calm, the set
+// rate while bonds break, boosted in a cycle's unloading too; refused under stress control,
+// which has no strain rate to boost.
+TEST(Protocols, OedometerRateBoostsWhileCalmAndNeedsStrainControl) {
+  Lab lab("oedometer-boost");
+  const std::string head = std::string("[protocol]\nname = \"boost\"\nrig = \"oedometer\"\n") +
+                           kSmallSample + "[loading]\nrate_boost_max = 4\n";
+  const std::string file =
+      writeProtocol("boost", head +
+                                 "axial_strain_rate_per_s = 5\naxial_strain_max = 0.01\n"
+                                 "cycle_at_axial_strain = [0.005]\n");
+  std::string out;
+  ASSERT_EQ(
+      rocklab::testing::runRocklab("run " + file + " --quiet --threads 1 --lab " + lab.path, &out),
+      0)
+      << out;
+  nb::Notebook n(lab.path);
+  const std::string rates = "SELECT %s(value) FROM series WHERE name = 'axial_strain_rate_per_s'";
+  auto rate = [&](const char* f) {
+    char sql[128];
+    std::snprintf(sql, sizeof sql, rates.c_str(), f);
+    return std::stod(scalar(n, sql));
+  };
+  EXPECT_DOUBLE_EQ(rate("max"), 20.0);   // 4 x 5 /s while calm
+  EXPECT_DOUBLE_EQ(rate("min"), -20.0);  // the cycle unloads boosted too
+  EXPECT_NE(scalar(n,
+                   "SELECT count(*) FROM series WHERE name = 'axial_strain_rate_per_s' AND "
+                   "value = 5"),
+            "0");  // back at the set rate while the cement breaks
+  const std::string refused = writeProtocol("boost-ramp", head + "control = \"stress_ramp\"\n");
+  EXPECT_EQ(rocklab::testing::runRocklab("run " + refused + " --lab " + lab.path + "-ramp", &out),
+            2);
+  EXPECT_NE(out.find("loading.rate_boost_max: the rate boost needs loading.control = strain_rate"),
+            std::string::npos)
+      << out;
+  std::filesystem::remove(file);
+  std::filesystem::remove(refused);
+}
+
 // The same rig with disks (2D), driven by a stress ramp.
 TEST(Protocols, DisksUnderAStressRamp) {
   Lab lab("disks");
