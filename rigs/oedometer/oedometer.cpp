@@ -132,8 +132,8 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
     }
     return l;
   };
-  // The axial strain rate now: the set one, times the boost while the sample is calm, down
-  // while a cycle unloads.
+  // The axial strain rate now: the set one times the boost (1 unless the sample is calm),
+  // negative while a cycle unloads.
   auto rateNow = [&] { return (phase == 1 ? -rate : rate) * h.rate.factor(); };
   auto record = [&] {
     const double edot = rateNow();
