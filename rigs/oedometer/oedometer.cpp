@@ -132,9 +132,10 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
     }
     return l;
   };
-  // The axial strain rate now: the set one times the boost (1 unless the sample is calm),
-  // negative while a cycle unloads.
-  auto rateNow = [&] { return (phase == 1 ? -rate : rate) * h.rate.factor(); };
+  // The axial strain rate now: the set one times the boost (1 unless the sample is calm)
+  // while loading; a cycle is a measurement of the moduli and runs at the set rate,
+  // negative while it unloads.
+  auto rateNow = [&] { return phase == 0 ? rate * h.rate.factor() : phase == 1 ? -rate : rate; };
   auto record = [&] {
     const double edot = rateNow();
     recordState(sp, rec, prefix, stage, strain_control ? edot : 0.0);
@@ -178,6 +179,7 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
       record();
       phase = 0;
       ++next_cycle;
+      h.rate = AdaptiveRate(s.boost);  // from the set rate again, rising as the sample stays calm
     }
     const bool finished = strain_control ? strain >= strain_max : stress >= stress_max;
     if (finished) {
