@@ -383,13 +383,13 @@ class ContactModelImpl final : public ContactModel<D> {
         const auto dissOf = [&](int k) -> ContactDissipation& {
           return B.cross_result[slot[k]].diss;
         };
-        const auto keep = [&](int k, std::uint32_t, std::uint32_t, const V& f, const A& ti,
-                              const A& tj) {
-          KeptContact<D>& c = B.cross_result[slot[k]];
+        const auto store = [](KeptContact<D>& c, const V& f, const A& ti, const A& tj) {
           c.f.force = f;
           c.f.torque_i = ti;
           c.f.torque_j = tj;
         };
+        const auto keep = [&](int k, std::uint32_t, std::uint32_t, const V& f, const A& ti,
+                              const A& tj) { store(B.cross_result[slot[k]], f, ti, tj); };
         for (std::size_t g = first; g < last; ++g) {
           KeptContact<D>& c = B.cross_result[g];
           c.diss = {};
@@ -403,12 +403,9 @@ class ContactModelImpl final : public ContactModel<D> {
             if (group.n == 4) flushEach<kEnergy>(v, group, dissOf, cross_over, keep);
             continue;
           }
-          c.touching = interact<kEnergy>(v, a, p, c.diss, cross_over,
-                                         [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
-                                           c.f.force = f;
-                                           c.f.torque_i = ti;
-                                           c.f.torque_j = tj;
-                                         });
+          c.touching = interact<kEnergy>(
+              v, a, p, c.diss, cross_over,
+              [&](std::uint32_t, const V& f, const A& ti, const A& tj) { store(c, f, ti, tj); });
         }
         flushEach<kEnergy>(v, group, dissOf, cross_over, keep);
       }

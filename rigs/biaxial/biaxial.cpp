@@ -163,12 +163,7 @@ LoadingHistory loadAxially(Specimen<D>& sp, const LoadingTest& test, double sigm
       h.unbalanced_sum += sim.unbalancedForceRatio();
       h.inertial_max = std::max(h.inertial_max, inertialNumber(sp, rate_now));
     }
-    if (test.boost.max > 1.0 && steps % AdaptiveRate::kWindowSteps == 0) {
-      const std::size_t breaks = sim.bondBreaks().size() + sim.clumpBreaks().size();
-      const double before = h.rate.factor();
-      const double factor = h.rate.update(breaks, sim.unbalancedForceRatio());
-      if (factor != before) frame.set(ax, Axis{Mode::StrainRate, rate * factor});
-    }
+    if (h.rate.window(steps, sim)) frame.set(ax, Axis{Mode::StrainRate, rate * h.rate.factor()});
     if (snapshot_every > 0 && steps % snapshot_every == 0) {
       snapshot(sp, rec, n.stage, "step " + std::to_string(steps));
     }

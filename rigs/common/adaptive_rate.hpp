@@ -48,6 +48,15 @@ class AdaptiveRate {
     factor_ = calm ? std::min(boost_.max, factor_ * kGrowth) : 1.0;
     return factor_;
   }
+  // The update at the end of each window of a stage's steps (counted from its start), from
+  // the simulation's breaks and balance; true when the factor changed. Nothing while off.
+  template <class Sim>
+  bool window(std::uint64_t steps, const Sim& sim) {
+    if (boost_.max <= 1.0 || steps % kWindowSteps != 0) return false;
+    const double before = factor_;
+    return update(sim.bondBreaks().size() + sim.clumpBreaks().size(), sim.unbalancedForceRatio()) !=
+           before;
+  }
   double factor() const { return factor_; }
   // Only the state: the settings come from the protocol again on a resume.
   template <class Archive>

@@ -188,13 +188,7 @@ OedometricHistory loadUniaxially(Specimen<D>& sp, const Settings& s, Recorder& r
       break;
     }
     if ((sim.steps() - start) % record_every == 0) record();
-    if (s.boost.max > 1.0 && (sim.steps() - start) % AdaptiveRate::kWindowSteps == 0) {
-      const std::size_t breaks = sim.bondBreaks().size() + sim.clumpBreaks().size();
-      const double before = h.rate.factor();
-      if (h.rate.update(breaks, sim.unbalancedForceRatio()) != before) {
-        frame.set(ax, Axis{Mode::StrainRate, rateNow()});
-      }
-    }
+    if (h.rate.window(sim.steps() - start, sim)) frame.set(ax, Axis{Mode::StrainRate, rateNow()});
     if (snapshot_every && (sim.steps() - start) % snapshot_every == 0) {
       snapshot(sp, rec, stage, "step " + std::to_string(sim.steps() - start));
     }
