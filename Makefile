@@ -107,7 +107,7 @@ GALLERY_DIR := build/gallery
 STUDY = $(ROCKLAB) study accuracy --threads 1 --quiet --lab $(GALLERY_DIR)/lab-$@.sqlite \
   --out $(GALLERY_DIR)/$@
 GALLERY := oedometer biaxial envelope hydrostatic permeameter ultrasonic fewer-steps \
-  oedometer-rate-boost
+  oedometer-rate-boost formation-end
 .PHONY: $(GALLERY)
 gallery: $(GALLERY)
 	@echo "gallery: reports/gallery/{$(shell echo $(GALLERY) | tr ' ' ,)}.png"
@@ -148,6 +148,12 @@ fewer-steps: build
 oedometer-rate-boost: build
 	$(STUDY) protocols/oedometer-formed-under-stress-quick.toml --vary loading.rate_boost_max=1,2 \
 	  --seeds 5
+	$(gallery_png)
+# A densification that ends sooner: its own lower damping, its end by porosity (both off in
+# the protocols: the first doubles the seed scatter, the two together weaken every seed).
+formation-end: build
+	$(STUDY) protocols/biaxial-ucs-quick.toml --vary formation.densified_porosity_change=0,0.0005 \
+	  --vary formation.local_damping=0.7,0.1 --seeds 5
 	$(gallery_png)
 
 format:

@@ -25,9 +25,14 @@ struct StudyPoint {
   // Per key result: the deviation lies inside the seed scatter, Welch's 95% interval of the
   // difference of the two means (lab/campaign/statistics.hpp); never with one seed.
   std::vector<bool> within_scatter;
+  // Per key result: the setting shifts it seed by seed. The same seed draws the same sample,
+  // so the differences from the finest's run of each seed cancel the sample's own scatter:
+  // shifted when their mean's 95% t interval excludes zero (two shared seeds or more). A
+  // shift inside the unpaired scatter is still one material made into another.
+  std::vector<bool> paired_shift;
   double error = 0.0;  // the largest deviation; infinite when a run failed or missed a value
-  // The largest deviation beyond the seed scatter: the accuracy the setting loses (with one
-  // seed, the error).
+  // The largest deviation beyond the seed scatter or shifted seed by seed: the accuracy the
+  // setting loses (with one seed, the error).
   double loss = 0.0;
   // The largest ratio of a key result's seed scatter (standard deviation) to the finest
   // setting's: a setting that widens it needs ratio^2 times the seeds for a mean as precise

@@ -8,30 +8,64 @@ namespace rocklab::rigs {
 
 namespace {
 
-// Runs the frame until the stresses hold and the sample is in equilibrium; returns the
-// steps it took.
+// When a densification may end before the unbalanced force ratio settles: the
+// frictionless grains creep into a denser packing for long after they are dense, and the
+// ratio then dips below its tolerance at a step that varies from seed to seed. A porosity
+// that no longer falls ends it at a defined state instead.
+struct Stall {
+  std::uint64_t window = 0;    // steps, 0: never
+  double porosity_change = 0;  // -, the fall over a window below which the packing is dense
+};
+
+// A settling's loop state (what a checkpoint inside it keeps).
+struct Settling {
+  std::uint64_t start = 0;
+  double porosity = 1.0;  // at the last stall window's start
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("start", start), ar("porosity", porosity);
+  }
+};
+
+// Runs the frame until the stresses hold and the sample is in equilibrium (or, with a
+// stall window, its porosity has stopped falling); returns the steps it took.
 template <int D>
-std::uint64_t settle(Specimen<D>& sp, const std::string& stage, Recorder& rec,
-                     RunControl& control) {
+std::uint64_t settle(Specimen<D>& sp, const std::string& stage, Recorder& rec, RunControl& control,
+                     const Stall& stall = {}) {
   Journal::Unit unit = control.unit("settle " + stage);
-  std::uint64_t start = sp.sim->steps(), done = 0;
+  Settling st{sp.sim->steps(), sp.frame->porosity()};
+  std::uint64_t done = 0;
   if (unit.done(done, sp)) return done;
-  unit.resume(start, sp);
+  unit.resume(st, sp);
   auto& sim = *sp.sim;
   const FormationSettings& f = sp.settings.formation;
   const auto record_every = static_cast<std::uint64_t>(sp.settings.output.record_every_steps);
   const auto max_steps = static_cast<std::uint64_t>(f.max_steps);
-  for (;; unit.tick(start, sp)) {
+  for (;; unit.tick(st, sp)) {
     sp.frame->step();
-    done = sim.steps() - start;
+    done = sim.steps() - st.start;
     if (done % record_every == 0) recordState(sp, rec, stage + ".", stage, 0.0);
     if (done % 100 != 0) continue;
     const double err = sp.frame->stressError(), u = sim.unbalancedForceRatio();
     control.tick(stage, sim.steps(), -1.0,
                  "stress error " + fmt(err) + ", unbalanced force ratio " + fmt(u));
-    if (err < f.stress_tolerance && u < f.unbalanced_force_ratio) {
+    const bool held = err < f.stress_tolerance;
+    if (held && u < f.unbalanced_force_ratio) {
       unit.finish(done, sp);
       return done;
+    }
+    if (stall.window > 0 && done % stall.window == 0) {
+      const double porosity = sp.frame->porosity(), fall = st.porosity - porosity;
+      st.porosity = porosity;
+      if (held && fall < stall.porosity_change) {
+        rec.message(sim.steps(), sim.time(), "info",
+                    stage + " ended by its porosity: it fell by " + fmt(fall) + " over the last " +
+                        std::to_string(stall.window) + " steps (formation." +
+                        "densified_porosity_change " + fmt(stall.porosity_change) +
+                        "), the unbalanced force ratio is " + fmt(u));
+        unit.finish(done, sp);
+        return done;
+      }
     }
     if (done >= max_steps) {
       std::ostringstream why;
@@ -83,7 +117,13 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
     // packing), then with the grains' own friction take the formation state: a deviatoric
     // stress the low friction could not hold.
     for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, f.lateral_stress, 0.0});
-    steps = settle(sp, "densification", rec, control);
+    sim.setLocalDamping(f.local_damping);
+    const Stall stall{f.densified_porosity_change > 0.0
+                          ? static_cast<std::uint64_t>(f.densified_window_steps)
+                          : 0,
+                      f.densified_porosity_change};
+    steps = settle(sp, "densification", rec, control, stall);
+    sim.setLocalDamping(sp.settings.simulation.local_damping);
     ownFriction();
     for (int a = 0; a < D; ++a) {
       const double target = a == Specimen<D>::kAxial ? f.axial_stress : f.lateral_stress;

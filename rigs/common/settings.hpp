@@ -156,6 +156,9 @@ struct FormationSettings {
   double stress_tolerance = 0.01;
   double unbalanced_force_ratio = 0.01;
   std::int64_t max_steps = 2000000;
+  double local_damping = 0.7;
+  double densified_porosity_change = 0.0;
+  std::int64_t densified_window_steps = 20000;
 
   template <class F>
   void fields(F& f) {
@@ -178,6 +181,16 @@ struct FormationSettings {
        "and the mean unbalanced force is below this fraction of the mean contact force"});
     f(max_steps, {"max_steps", units::none, Range::closed(100, 1e10),
                   "give up settling after this many steps"});
+    f(local_damping, {"local_damping", units::none, Range::rightOpen(0, 1),
+                      "local damping while the sample is densified (numerics.local_damping "
+                      "is the rest's); less lets the frictionless grains rearrange sooner"});
+    f(densified_porosity_change,
+      {"densified_porosity_change", units::none, Range::closed(0, 0.1),
+       "densification also ends, with the walls at their stress, when the porosity fell by "
+       "less than this over formation.densified_window_steps (0: only the unbalanced force "
+       "ratio ends it)"});
+    f(densified_window_steps, {"densified_window_steps", units::none, Range::closed(100, 1e9),
+                               "the window of formation.densified_porosity_change"});
   }
 };
 

@@ -296,6 +296,43 @@ TEST(Protocols, OedometerRateBoostsWhileCalmAndNeedsStrainControl) {
   std::filesystem::remove(refused);
 }
 
+// The densification's own damping (formation.local_damping) and its end by porosity
+// (formation.densified_porosity_change): the densification runs at its damping, what comes
+// after at numerics.local_damping again, and a porosity that stops falling ends it.
+TEST(Protocols, DensificationHasItsOwnDampingAndEndsWhenItsPorosityStopsFalling) {
+  const std::string head = std::string("[protocol]\nname = \"densify\"\nrig = \"oedometer\"\n") +
+                           kSmallSample + "[loading]\naxial_strain_max = 0.002\n";
+  // Any fall below 5% in 200 steps ends it: at the first window with the walls at stress.
+  const std::string stall =
+      " --set formation.local_damping=0.3 --set formation.densified_porosity_change=0.05"
+      " --set formation.densified_window_steps=200";
+  const std::string file = writeProtocol("densify", head);
+  auto run = [&](const Lab& lab, const std::string& keys) {
+    std::string out;
+    EXPECT_EQ(rocklab::testing::runRocklab(
+                  "run " + file + " --quiet --threads 1 --lab " + lab.path + keys, &out),
+              0)
+        << out;
+    return nb::Notebook(lab.path);
+  };
+  Lab a("densify-a"), b("densify-b"), c("densify-c");
+  nb::Notebook na = run(a, stall), nb = run(b, stall + " --set numerics.local_damping=0.3"),
+               nc = run(c, "");
+  const std::string ended =
+      "SELECT count(*) FROM messages WHERE text LIKE 'densification ended by its porosity%'";
+  EXPECT_EQ(scalar(na, ended), "1");
+  EXPECT_EQ(scalar(nc, ended), "0");
+  EXPECT_LT(result(na, "formation_steps"), result(nc, "formation_steps"));
+  const std::string path =
+      "SELECT group_concat(step || ':' || value, ' ') FROM series WHERE "
+      "name = 'densification.porosity'";
+  EXPECT_EQ(scalar(na, path), scalar(nb, path));  // the densification at its own damping
+  EXPECT_NE(scalar(na, path).substr(0, 40), scalar(nc, path).substr(0, 40));
+  const std::string hash = "SELECT text FROM messages WHERE text LIKE 'final state hash%'";
+  EXPECT_NE(scalar(na, hash), scalar(nb, hash));  // the loading at numerics.local_damping
+  std::filesystem::remove(file);
+}
+
 // The same rig with disks (2D), driven by a stress ramp.
 TEST(Protocols, DisksUnderAStressRamp) {
   Lab lab("disks");

@@ -207,7 +207,9 @@ TEST(AccuracyStudy, ErrorParetoFrontAndCheapestWithinTolerance) {
 
 // A study over seeds: runs that differ only in their seed are one setting, compared by their
 // means. A deviation the seeds cannot resolve is no loss of accuracy, one beyond the scatter
-// is: with a 1% tolerance the cheapest is the setting 2.5% off inside the scatter.
+// is, and so is one the seeds resolve in pairs (the same seed is the same sample): with a 1%
+// tolerance the cheapest is the setting 2.5% off inside the scatter, not the faster one 2%
+// off inside it but shifted at every seed.
 TEST(AccuracyStudy, ADeviationInsideTheSeedScatterIsNoLoss) {
   const std::string lab = (std::filesystem::temp_directory_path() /
                            ("rocklab-study-seeds-" + std::to_string(::getpid()) + ".sqlite"))
@@ -217,9 +219,13 @@ TEST(AccuracyStudy, ADeviationInsideTheSeedScatterIsNoLoss) {
     double safety, seconds;
     std::vector<double> peaks;  // at seeds 1, 2, 3
   };
-  // Means 25, 25.63 (2.5% off, Welch half-width about 2.5 MPa) and 30 (20% off, resolved).
-  const std::vector<Row> rows = {
-      {0.2, 100, {25.0, 26.0, 24.0}}, {0.4, 40, {25.6, 26.4, 24.9}}, {0.8, 10, {30.0, 31.0, 29.0}}};
+  // Means 25, 25.63 (2.5% off, Welch half-width about 2.5 MPa; seed by seed +1.4, -1.1,
+  // +1.6), 30 (20% off, resolved) and 25.5 (2% off, inside the scatter, but +0.5, +0.6, +0.4:
+  // the paired interval 0.5 +- 0.25 excludes zero).
+  const std::vector<Row> rows = {{0.2, 100, {25.0, 26.0, 24.0}},
+                                 {0.4, 40, {26.4, 24.9, 25.6}},
+                                 {0.8, 10, {30.0, 31.0, 29.0}},
+                                 {0.9, 5, {25.5, 26.6, 24.4}}};
   std::vector<std::int64_t> ids;
   {
     notebook::Notebook nb(lab);
@@ -243,14 +249,18 @@ TEST(AccuracyStudy, ADeviationInsideTheSeedScatterIsNoLoss) {
   const Study s = evaluateStudy(lab, ids, 0.01);
   EXPECT_EQ(s.varied, std::vector<std::string>{"numerics.timestep_safety"});
   EXPECT_EQ(s.seeds, 3u);
-  ASSERT_EQ(s.points.size(), 3u);
+  ASSERT_EQ(s.points.size(), 4u);
   EXPECT_EQ(s.points[1].runs, (std::vector<std::int64_t>{ids[3], ids[4], ids[5]}));
   EXPECT_NEAR(s.points[1].wall_seconds, 41.0, 1e-9);
   EXPECT_NEAR(*s.points[1].values[0], 76.9 / 3.0, 1e-9);
   EXPECT_NEAR(*s.points[1].spread[0], 1.0, 0.3);
   EXPECT_NEAR(s.points[1].error, (76.9 / 3.0 - 25.0) / 25.0, 1e-9);
   EXPECT_TRUE(s.points[1].within_scatter[0]);
+  EXPECT_FALSE(s.points[1].paired_shift[0]);
   EXPECT_DOUBLE_EQ(s.points[1].loss, 0.0);
+  EXPECT_TRUE(s.points[3].within_scatter[0]);
+  EXPECT_TRUE(s.points[3].paired_shift[0]);
+  EXPECT_NEAR(s.points[3].loss, 0.02, 1e-9);
   EXPECT_FALSE(s.points[2].within_scatter[0]);
   EXPECT_NEAR(s.points[2].loss, 0.2, 1e-9);
   EXPECT_EQ(s.cheapest, 1);
@@ -262,6 +272,7 @@ TEST(AccuracyStudy, ADeviationInsideTheSeedScatterIsNoLoss) {
   std::ifstream in(out + "/index.html");
   const std::string page(std::istreambuf_iterator<char>(in), {});
   EXPECT_NE(page.find("inside the scatter"), std::string::npos);
+  EXPECT_NE(page.find("inside the scatter, shifted seed by seed"), std::string::npos);
   EXPECT_NE(page.find("is not a loss of accuracy"), std::string::npos);
   std::filesystem::remove_all(out);
   for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(lab + ext);
