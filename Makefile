@@ -107,7 +107,8 @@ GALLERY_DIR := build/gallery
 STUDY = $(ROCKLAB) study accuracy --threads 1 --quiet --lab $(GALLERY_DIR)/lab-$@.sqlite \
   --out $(GALLERY_DIR)/$@
 GALLERY := oedometer biaxial envelope hydrostatic permeameter ultrasonic fewer-steps \
-  oedometer-rate-boost formation-end
+  oedometer-rate-boost formation-end compaction-band-rate-boost shear-band-rate-boost \
+  envelope-rate-boost
 .PHONY: $(GALLERY)
 gallery: $(GALLERY)
 	@echo "gallery: reports/gallery/{$(shell echo $(GALLERY) | tr ' ' ,)}.png"
@@ -154,6 +155,17 @@ oedometer-rate-boost: build
 formation-end: build
 	$(STUDY) protocols/biaxial-ucs-quick.toml --vary formation.densified_porosity_change=0,0.0005 \
 	  --vary formation.local_damping=0.7,0.1 --seeds 5
+	$(gallery_png)
+# The adaptive rate in the 2D band protocols and the envelope (on in all three).
+compaction-band-rate-boost: build
+	$(STUDY) protocols/biaxial-compaction-band-quick.toml --vary loading.rate_boost_max=1,2 \
+	  --seeds 5
+	$(gallery_png)
+shear-band-rate-boost: build
+	$(STUDY) protocols/biaxial-shear-band-quick.toml --vary loading.rate_boost_max=1,2 --seeds 5
+	$(gallery_png)
+envelope-rate-boost: build
+	$(STUDY) protocols/triaxial-envelope-quick.toml --vary loading.rate_boost_max=1,2 --seeds 5
 	$(gallery_png)
 
 format:

@@ -11,7 +11,8 @@ namespace {
 // When a densification may end before the unbalanced force ratio settles: the
 // frictionless grains creep into a denser packing for long after they are dense, and the
 // ratio then dips below its tolerance at a step that varies from seed to seed. A porosity
-// that no longer falls ends it at a defined state instead.
+// that no longer falls may end it instead (off in the protocols: ending sooner changes the
+// material, rigs/README.md).
 struct Stall {
   std::uint64_t window = 0;    // steps, 0: never
   double porosity_change = 0;  // -, the fall over a window below which the packing is dense
