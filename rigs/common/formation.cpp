@@ -14,8 +14,8 @@ namespace {
 // that no longer falls may end it instead (off in the protocols: ending sooner changes the
 // material, rigs/README.md).
 struct Stall {
-  std::uint64_t window = 0;    // steps, 0: never
-  double porosity_change = 0;  // -, the fall over a window below which the packing is dense
+  std::uint64_t window = 1;    // steps
+  double porosity_change = 0;  // -, the fall over a window below which it is dense; 0: never
 };
 
 // A settling's loop state (what a checkpoint inside it keeps).
@@ -55,15 +55,15 @@ std::uint64_t settle(Specimen<D>& sp, const std::string& stage, Recorder& rec, R
       unit.finish(done, sp);
       return done;
     }
-    if (stall.window > 0 && done % stall.window == 0) {
+    if (stall.porosity_change > 0.0 && done % stall.window == 0) {
       const double porosity = sp.frame->porosity(), fall = st.porosity - porosity;
       st.porosity = porosity;
       if (held && fall < stall.porosity_change) {
         rec.message(sim.steps(), sim.time(), "info",
                     stage + " ended by its porosity: it fell by " + fmt(fall) + " over the last " +
-                        std::to_string(stall.window) + " steps (formation." +
-                        "densified_porosity_change " + fmt(stall.porosity_change) +
-                        "), the unbalanced force ratio is " + fmt(u));
+                        std::to_string(stall.window) +
+                        " steps (formation.densified_porosity_change " +
+                        fmt(stall.porosity_change) + "), the unbalanced force ratio is " + fmt(u));
         unit.finish(done, sp);
         return done;
       }
@@ -119,9 +119,7 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
     // stress the low friction could not hold.
     for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, f.lateral_stress, 0.0});
     sim.setLocalDamping(f.local_damping);
-    const Stall stall{f.densified_porosity_change > 0.0
-                          ? static_cast<std::uint64_t>(f.densified_window_steps)
-                          : 0,
+    const Stall stall{static_cast<std::uint64_t>(f.densified_window_steps),
                       f.densified_porosity_change};
     steps = settle(sp, "densification", rec, control, stall);
     sim.setLocalDamping(sp.settings.simulation.local_damping);
