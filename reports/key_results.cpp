@@ -205,6 +205,21 @@ std::vector<KeyResultRule> ultrasonicRules() {
   };
 }
 
+std::vector<KeyResultRule> brazilianRules() {
+  return {
+      rec("tensile_strength_MPa"),    rec("peak_force_N"),
+      rec("broken_bonds_at_peak"),    rec("fracture_angle_to_loading_deg"),
+      rec("fracture_through_centre"),
+  };
+}
+
+std::vector<KeyResultRule> directTensionRules() {
+  return {
+      rec("tensile_strength_MPa"), rec("tensile_modulus_MPa"),   rec("axial_strain_at_peak"),
+      rec("broken_bonds_at_peak"), rec("fracture_height_ratio"),
+  };
+}
+
 struct RigRules {
   std::string_view rig;
   std::vector<KeyResultRule> rules;
@@ -215,6 +230,7 @@ const std::vector<RigRules>& table() {
       {"oedometer", oedometerRules()},     {"biaxial", biaxialRules()},
       {"envelope", envelopeRules()},       {"hydrostatic", hydrostaticRules()},
       {"permeameter", permeameterRules()}, {"ultrasonic", ultrasonicRules()},
+      {"brazilian", brazilianRules()},     {"direct_tension", directTensionRules()},
   };
   return t;
 }

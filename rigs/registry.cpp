@@ -5,6 +5,8 @@
 #include "rigs/hydrostatic/hydrostatic.hpp"
 #include "rigs/oedometer/oedometer.hpp"
 #include "rigs/permeameter/permeameter.hpp"
+#include "rigs/tensile/brazilian.hpp"
+#include "rigs/tensile/direct.hpp"
 #include "rigs/ultrasonic/ultrasonic.hpp"
 
 namespace rocklab::rigs {
@@ -35,6 +37,15 @@ const std::vector<RigEntry>& rigTable() {
           "ultrasonic bench: P and S waves (pz, px, szx, sxy) through copies of a sample at "
           "stages of hydrostatic, uniaxial-strain or triaxial loading; FFT-picked velocities, "
           "dynamic and static moduli"),
+      rigEntry<brazilian::Settings, brazilian::run>(
+          "brazilian",
+          "Brazilian test: a disk (2D) or cylinder (3D) cut from the formed, cemented sample, "
+          "loaded along its diameter between flat platens; sigma_t = 2 F / (pi D t) and the "
+          "fracture"),
+      rigEntry<direct_tension::Settings, direct_tension::run>(
+          "direct_tension",
+          "direct tension: the formed, cemented sample out of its box, its end layers glued to "
+          "the platens and pulled apart; tensile strength and modulus in tension"),
   };
   return table;
 }

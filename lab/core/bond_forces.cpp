@@ -23,6 +23,11 @@ BondKind BondKind::grains() {
 }
 
 void BondKind::validate() const {
+  if (model == BondModel::FlatJoint && moment_factor != 1.0) {
+    throw InvalidParameter("", "moment_factor",
+                           "applies to parallel bonds only: a flat joint's elements break on "
+                           "their centroid stresses (leave it at 1 with model = flat_joint)");
+  }
   if (negative == NegativeStrength::Resample && (tensile_mean <= 0.0 || shear_mean <= 0.0)) {
     throw InvalidParameter("", "negative_strength",
                            "resample needs positive mean strengths (it draws until positive)");
@@ -37,12 +42,13 @@ void BondStore<D>::removeFlagged(const std::vector<std::uint8_t>& broken) {
     if (out != b) {
       i[out] = i[b], j[out] = j[b], kind[out] = kind[b], radius[out] = radius[b];
       kn[out] = kn[b], ks[out] = ks[b], tensile[out] = tensile[b], shear[out] = shear[b];
-      load[out] = load[b];
+      load[out] = load[b], face[out] = std::move(face[b]);
     }
     ++out;
   }
   i.resize(out), j.resize(out), kind.resize(out), radius.resize(out), kn.resize(out);
   ks.resize(out), tensile.resize(out), shear.resize(out), load.resize(out);
+  face.resize(out);
 }
 
 bool bondLanesAvailable() {
@@ -73,8 +79,7 @@ void BondForces<D>::compute(BondPass<D>& pass) {
   const std::size_t nb = B.size();
   const std::size_t blocks = (nb + kBlockRows - 1) / kBlockRows;
   const double dt = pass.dt;
-  block_broken_.assign(blocks, {});
-  block_modes_.assign(blocks, {});
+  block_.assign(blocks, {});
   if (pass.threaded) {
     active_.resize(nb);
     force_.resize(nb);
@@ -85,12 +90,17 @@ void BondForces<D>::compute(BondPass<D>& pass) {
 
   tan_friction_.clear();
   moment_factor_.clear();
+  joint_friction_.clear();
+  layouts_.clear();
   bool frictional = false, moments_scaled = false;
   if (pass.kinds) {
     for (const BondKind& k : *pass.kinds) {
       tan_friction_.push_back(std::tan(k.friction_angle));
       moment_factor_.push_back(k.moment_factor);
-      frictional = frictional || k.friction_angle > 0.0;
+      joint_friction_.push_back(k.flat_joint_friction);
+      layouts_.push_back(k.model == BondModel::FlatJoint ? k.template faceLayout<D>()
+                                                         : FaceLayout{});
+      frictional = frictional || (k.friction_angle > 0.0 && k.model == BondModel::Parallel);
       moments_scaled = moments_scaled || k.moment_factor != 1.0;
     }
   }
@@ -115,28 +125,9 @@ void BondForces<D>::compute(BondPass<D>& pass) {
     return sigma_n > 0.0 ? B.shear[b] + sigma_n * tan_friction_[B.kind[b]] : B.shear[b];
   };
 
-  // A bond's outcome, the same from either path: at or past its strength it breaks now and
-  // carries nothing more (the larger ratio of stress to strength names the mode when both
-  // are reached); else its force and torques go to its particles (threaded: to its slots).
-  auto settle = [&](std::size_t blk, std::size_t b, const Vec<D>& force, const Ang<D>& ti,
-                    const Ang<D>& tj, double tensile_stress, double shear_stress)
+  // A bond's force and torques go to its particles (threaded: to its slots).
+  auto apply = [&](std::size_t b, const Vec<D>& force, const Ang<D>& ti, const Ang<D>& tj)
       __attribute__((always_inline)) {
-    double shear_strength = B.shear[b];
-    if (pass.breakable && (moments_scaled || frictional)) {  // only breaks need them
-      const auto section = BondSection<D>::of(B.radius[b], P.thickness);
-      if (moments_scaled) scaledStresses(b, section, tensile_stress, shear_stress);
-      if (frictional) shear_strength = frictionalStrength(b, section);
-    }
-    if (pass.breakable && (tensile_stress >= B.tensile[b] || shear_stress >= shear_strength)) {
-      const double rt = tensile_stress / B.tensile[b], rs = shear_stress / shear_strength;
-      const bool tensile =
-          tensile_stress >= B.tensile[b] && (shear_stress < shear_strength || rt >= rs);
-      block_broken_[blk].push_back(static_cast<std::uint32_t>(b));
-      block_modes_[blk].push_back({tensile ? BondBreakMode::Tensile : BondBreakMode::Shear,
-                                   tensile ? tensile_stress : shear_stress});
-      if (pass.threaded) active_[b] = 0;
-      return;
-    }
     const std::uint32_t i = B.i[b], j = B.j[b];
     if (pass.threaded) {
       active_[b] = 1;
@@ -150,14 +141,40 @@ void BondForces<D>::compute(BondPass<D>& pass) {
       P.torque[j] += tj;
     }
   };
-  auto one = [&](std::size_t blk, std::size_t b) {
+  // A parallel bond's outcome, the same from either path: at or past its strength it breaks
+  // now and carries nothing more (the larger ratio of stress to strength names the mode when
+  // both are reached); else its force and torques are applied.
+  auto settle = [&](std::size_t blk, std::size_t b, const Vec<D>& force, const Ang<D>& ti,
+                    const Ang<D>& tj, double tensile_stress, double shear_stress)
+      __attribute__((always_inline)) {
+    double shear_strength = B.shear[b];
+    if (pass.breakable && (moments_scaled || frictional)) {  // only breaks need them
+      const auto section = BondSection<D>::of(B.radius[b], P.thickness);
+      if (moments_scaled) scaledStresses(b, section, tensile_stress, shear_stress);
+      if (frictional) shear_strength = frictionalStrength(b, section);
+    }
+    if (pass.breakable && (tensile_stress >= B.tensile[b] || shear_stress >= shear_strength)) {
+      const double rt = tensile_stress / B.tensile[b], rs = shear_stress / shear_strength;
+      const bool tensile =
+          tensile_stress >= B.tensile[b] && (shear_stress < shear_strength || rt >= rs);
+      block_[blk].breaks.push_back(
+          {static_cast<std::uint32_t>(b), tensile ? BondBreakMode::Tensile : BondBreakMode::Shear,
+           tensile ? tensile_stress : shear_stress, 0.0, Vec<D>::Zero(), true});
+      if (pass.threaded) active_[b] = 0;
+      return;
+    }
+    apply(b, force, ti, tj);
+  };
+  // Bond b's kinematics at its contact point, with the lever arms li, lj (gaps and overlaps
+  // shared halfway).
+  auto kinematics = [&](std::size_t b, double& li, double& lj) {
     const std::uint32_t i = B.i[b], j = B.j[b];
     const Vec<D> d = P.pos[j] - P.pos[i];
     const double dist = d.norm();
     BondKinematics<D> k;
     k.n = d / dist;
     const double overlap = P.radius[i] + P.radius[j] - dist;  // < 0: a gap
-    const double li = P.radius[i] - 0.5 * overlap, lj = P.radius[j] - 0.5 * overlap;
+    li = P.radius[i] - 0.5 * overlap, lj = P.radius[j] - 0.5 * overlap;
     k.vc = P.vel[j] - P.vel[i] - cross(Ang<D>(lj * P.spin[j] + li * P.spin[i]), k.n);
     k.dspin = P.spin[j] - P.spin[i];
     if constexpr (D == 3) {
@@ -165,10 +182,45 @@ void BondForces<D>::compute(BondPass<D>& pass) {
     } else {
       k.spin_n = 0.0;
     }
+    return k;
+  };
+  auto one = [&](std::size_t blk, std::size_t b) {
+    double li, lj;
+    const BondKinematics<D> k = kinematics(b, li, lj);
     const auto section = BondSection<D>::of(B.radius[b], P.thickness);
     const BondResult<D> r = bondForce<D>(section, B.kn[b], B.ks[b], k, B.load[b], dt);
     const Ang<D> ncf = cross(k.n, B.load[b].fs);
     settle(blk, b, r.force, li * ncf + r.moment, r.moment - lj * ncf, r.tensile, r.shear);
+  };
+  auto joint = [&](std::size_t blk, std::size_t b) {
+    double li, lj;
+    const BondKinematics<D> k = kinematics(b, li, lj);
+    const std::uint8_t kind = B.kind[b];
+    FaceMaterial m;
+    m.radius = B.radius[b], m.thickness = P.thickness, m.kn = B.kn[b], m.ks = B.ks[b];
+    m.tensile = B.tensile[b], m.cohesion = B.shear[b];
+    m.tan_friction_angle = tan_friction_[kind], m.friction = joint_friction_[kind];
+    m.breakable = pass.breakable;
+    std::vector<ElementBreak<D>> element_breaks;  // allocates only when one breaks
+    const FaceResult<D> r = flatJointStep<D>(layouts_[kind], m, k.n, k.vc, k.dspin, k.spin_n,
+                                             B.face[b], dt, element_breaks);
+    BlockOut& out = block_[blk];
+    for (const ElementBreak<D>& e : element_breaks) {
+      out.breaks.push_back({static_cast<std::uint32_t>(b),
+                            e.tensile ? BondBreakMode::Tensile : BondBreakMode::Shear, e.stress,
+                            e.energy, e.offset, false});
+    }
+    out.slip_energy += r.slip_energy;
+    if (r.released) out.released.push_back(static_cast<std::uint32_t>(b));
+    const Ang<D> ncf = cross(k.n, r.shear);
+    apply(b, r.force, li * ncf + r.moment, r.moment - lj * ncf);
+  };
+  auto scalar = [&](std::size_t blk, std::size_t b) {
+    if (B.face[b].empty()) {
+      one(blk, b);
+    } else {
+      joint(blk, b);
+    }
   };
 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(pass.threads) if (pass.threaded)
@@ -176,10 +228,13 @@ void BondForces<D>::compute(BondPass<D>& pass) {
     const std::size_t end = std::min(nb, (blk + 1) * kBlockRows);
     std::size_t b = blk * kBlockRows;
     if (pass.lanes && lanes::available()) {
-      // Each group is settled after the next one is computed: its results are ready by
-      // then, and its scalar scatter overlaps the tail of the next group's chain.
+      // Four parallel bonds at a time. Each group is settled after the next one is computed:
+      // its results are ready by then, and its scalar scatter overlaps the tail of the next
+      // group's chain. A flat joint among the next four goes alone, on the scalar path.
       using Settled = std::conditional_t<D == 3, lanes::Settled, lanes::Settled2>;
       Settled s[2];
+      int slot = 0;
+      std::size_t pending = end;  // the group computed but not yet settled
       auto settleFour = [&](std::size_t first, const Settled& r) {
         for (int k = 0; k < 4; ++k) {
           if constexpr (D == 3) {
@@ -192,14 +247,26 @@ void BondForces<D>::compute(BondPass<D>& pass) {
           }
         }
       };
-      const std::size_t first = b;
-      for (; b + 4 <= end; b += 4) {
-        lanes::fourBonds(P, B, b, dt, s[(b / 4) & 1]);
-        if (b > first) settleFour(b - 4, s[((b - 4) / 4) & 1]);
+      auto flush = [&] {
+        if (pending != end) settleFour(pending, s[slot ^ 1]);
+        pending = end;
+      };
+      while (b + 4 <= end) {
+        if (!(B.face[b].empty() && B.face[b + 1].empty() && B.face[b + 2].empty() &&
+              B.face[b + 3].empty())) {
+          flush();  // in bond order: the breaks of a block stay sorted
+          scalar(blk, b++);
+          continue;
+        }
+        lanes::fourBonds(P, B, b, dt, s[slot]);
+        if (pending != end) settleFour(pending, s[slot ^ 1]);
+        pending = b;
+        slot ^= 1;
+        b += 4;
       }
-      if (b > first) settleFour(b - 4, s[((b - 4) / 4) & 1]);
+      flush();
     }
-    for (; b < end; ++b) one(blk, b);  // no AVX, or the block's last few bonds
+    for (; b < end; ++b) scalar(blk, b);  // no AVX, or the block's last few bonds
   }
 
   if (pass.threaded) {
@@ -222,12 +289,17 @@ void BondForces<D>::compute(BondPass<D>& pass) {
       P.torque[p] = t;
     }
   }
-  for (std::size_t blk = 0; blk < blocks; ++blk) {
-    for (std::size_t k = 0; k < block_broken_[blk].size(); ++k) {
-      pass.broken.push_back(block_broken_[blk][k]);
-      pass.modes.push_back(block_modes_[blk][k].first);
-      pass.stresses.push_back(block_modes_[blk][k].second);
+  for (const BlockOut& out : block_) {
+    for (const Break& k : out.breaks) {
+      pass.broken.push_back(k.bond);
+      pass.modes.push_back(k.mode);
+      pass.stresses.push_back(k.stress);
+      pass.removes.push_back(k.removes ? 1 : 0);
+      pass.offsets.push_back(k.offset);
+      pass.energies.push_back(k.energy);
     }
+    pass.released.insert(pass.released.end(), out.released.begin(), out.released.end());
+    pass.slip_energy += out.slip_energy;
   }
 }
 

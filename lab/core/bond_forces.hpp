@@ -20,10 +20,20 @@ struct BondPass {
   int threads;
   bool breakable;  // false: no bond breaks, whatever its load
 
-  // Out: the bonds that broke this step, by increasing index, with mode and stress.
+  // Out: the breaks this step, by increasing bond index, with mode and stress. A parallel
+  // bond breaks whole (`removes`); a flat joint breaks element by element and stays, its
+  // element's centroid at `offsets` from the bond's centre and the elastic energy it gave up
+  // in `energies` (a parallel bond's is its load's, which it keeps).
   std::vector<std::uint32_t> broken;
   std::vector<BondBreakMode> modes;
   std::vector<double> stresses;
+  std::vector<std::uint8_t> removes;
+  std::vector<Vec<D>> offsets;
+  std::vector<double> energies;
+  // Out: flat joints every element of which is broken and apart, to remove without a break;
+  // the energy the broken elements' friction dissipated (J).
+  std::vector<std::uint32_t> released;
+  double slip_energy = 0.0;
 
   bool lanes = true;  // 3D: four bonds per AVX register where the CPU has it (same bits)
   // The kinds, indexed by BondStore::kind, for their friction angles and moment factors
@@ -50,9 +60,22 @@ class BondForces {
   std::vector<Ang<D>> torque_i_, torque_j_;
   std::vector<std::uint32_t> adjacency_row_, adjacency_;
   bool adjacency_valid_ = false;
-  std::vector<std::vector<std::uint32_t>> block_broken_;
-  std::vector<std::vector<std::pair<BondBreakMode, double>>> block_modes_;
-  std::vector<double> tan_friction_, moment_factor_;  // per kind, this pass
+  // A break found in a block of bonds, and the block's flat joints released.
+  struct Break {
+    std::uint32_t bond;
+    BondBreakMode mode;
+    double stress, energy;
+    Vec<D> offset;
+    bool removes;
+  };
+  struct BlockOut {
+    std::vector<Break> breaks;
+    std::vector<std::uint32_t> released;
+    double slip_energy = 0.0;
+  };
+  std::vector<BlockOut> block_;
+  std::vector<double> tan_friction_, moment_factor_, joint_friction_;  // per kind, this pass
+  std::vector<FaceLayout> layouts_;                                    // per kind (flat joints)
 };
 
 }  // namespace rocklab

@@ -14,6 +14,7 @@
 #include "lab/core/contact_kernels.hpp"
 #include "lab/core/dim.hpp"
 #include "lab/core/fields.hpp"
+#include "lab/core/flat_joint.hpp"
 #include "lab/core/particles.hpp"
 
 namespace rocklab {
@@ -53,6 +54,14 @@ struct BondKind {
   // 1: the full beam stresses (Potyondy & Cundall 2004, the paper's).
   double moment_factor = 1.0;
   NegativeStrength negative = NegativeStrength::Skip;
+  // The cement's model: PFC's parallel bond, or its flat joint (flat_joint.hpp), whose face of
+  // radius R carries the same stiffness cut into elements that break one by one. A flat joint
+  // breaks on its elements' centroid stresses, so moment_factor does not apply to it;
+  // tensile and shear strengths are its elements' tensile strength and cohesion.
+  BondModel model = BondModel::Parallel;
+  std::int64_t flat_joint_radial = 2;           // 2D: elements along the face; 3D: rings
+  std::int64_t flat_joint_circumferential = 3;  // 3D: sectors per ring (PFC's usual 1 x 3)
+  double flat_joint_friction = 0.5;             // -, friction coefficient of broken elements
 
   // The intragranular bonds of breakable grains: stiffer and stronger than the cement, and
   // never missing (a grain is not born cracked: draws <= 0 are drawn again).
@@ -88,6 +97,21 @@ struct BondKind {
        {},
        "a strength drawn <= 0: skip (no bond: it would break unloaded) or resample"},
       kNegative);
+    static constexpr Choice<BondModel> kModel[] = {{"parallel", BondModel::Parallel},
+                                                   {"flat_joint", BondModel::FlatJoint}};
+    f(model,
+      {"model",
+       units::text,
+       {},
+       "parallel (Potyondy & Cundall 2004) or flat_joint (Potyondy 2012)"},
+      kModel);
+    f(flat_joint_radial, {"flat_joint_elements_radial", units::none, Range::closed(1, 16),
+                          "flat joint: 2D elements along the face, 3D rings of elements"});
+    f(flat_joint_circumferential,
+      {"flat_joint_elements_circumferential", units::none, Range::closed(1, 16),
+       "flat joint, 3D: elements around each ring"});
+    f(flat_joint_friction, {"flat_joint_friction", units::none, Range::closed(0, 10),
+                            "flat joint: friction coefficient of the broken elements"});
   }
   // A mean at or below zero with Resample would loop for ever drawing a positive strength.
   void validate() const;
@@ -98,7 +122,14 @@ struct BondKind {
     ar("tensile_mean", tensile_mean), ar("tensile_std", tensile_std);
     ar("shear_mean", shear_mean), ar("shear_std", shear_std);
     ar("friction_angle", friction_angle), ar("moment_factor", moment_factor);
-    ar("negative", negative);
+    ar("negative", negative), ar("model", model), ar("flat_joint_radial", flat_joint_radial);
+    ar("flat_joint_circumferential", flat_joint_circumferential);
+    ar("flat_joint_friction", flat_joint_friction);
+  }
+  template <int D>
+  FaceLayout faceLayout() const {
+    return FaceLayout::of<D>(static_cast<int>(flat_joint_radial),
+                             static_cast<int>(flat_joint_circumferential));
   }
 };
 
@@ -208,16 +239,26 @@ struct BondStore {
   std::vector<double> radius;          // m, R
   std::vector<double> kn, ks;          // Pa/m, stiffness per area
   std::vector<double> tensile, shear;  // Pa, strengths
-  std::vector<BondLoad<D>> load;
+  std::vector<BondLoad<D>> load;       // parallel bonds
+  std::vector<FaceState<D>> face;      // flat joints (empty for a parallel bond)
 
   std::size_t size() const { return i.size(); }
+  // Whether bond b still holds cement: a parallel bond always (a break removes it), a flat
+  // joint while one of its elements is bonded.
+  bool intact(std::size_t b) const {
+    if (face[b].empty()) return true;
+    for (const auto& e : face[b].elements) {
+      if (e.bonded) return true;
+    }
+    return false;
+  }
   // Keeps the bonds whose flag is 0, in order.
   void removeFlagged(const std::vector<std::uint8_t>& broken);
 
   template <class Archive>
   void visit(Archive& ar) {
     ar("i", i), ar("j", j), ar("kind", kind), ar("radius", radius), ar("kn", kn), ar("ks", ks);
-    ar("tensile", tensile), ar("shear", shear), ar("load", load);
+    ar("tensile", tensile), ar("shear", shear), ar("load", load), ar("face", face);
   }
 };
 

@@ -46,7 +46,11 @@ Frame captureFrame(const Simulation<D>& sim) {
   }
   const auto& B = sim.bonds();
   for (std::size_t b = 0; b < B.size(); ++b) {
-    f.bonds.push_back({P.slot_of[B.i[b]], P.slot_of[B.j[b]], B.load[b].fn, B.load[b].fs.norm()});
+    if (!B.intact(b)) continue;  // a flat joint broken through is a frictional interface
+    const bool joint = !B.face[b].empty();
+    f.bonds.push_back({P.slot_of[B.i[b]], P.slot_of[B.j[b]],
+                       joint ? B.face[b].normal_force : B.load[b].fn,
+                       joint ? B.face[b].shear_force : B.load[b].fs.norm()});
     f.bond_kind.push_back(B.kind[b]);
   }
   for (const auto& w : sim.walls())

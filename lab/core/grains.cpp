@@ -294,7 +294,7 @@ std::vector<std::uint32_t> grainFragments(const ParticleStore<D>& P, const BondS
     return a;
   };
   for (std::size_t b = 0; b < bonds.size(); ++b) {
-    if (!kinds.at(bonds.kind[b]).intragranular) continue;
+    if (!kinds.at(bonds.kind[b]).intragranular || !bonds.intact(b)) continue;
     const std::uint32_t a = root(bonds.i[b]), c = root(bonds.j[b]);
     if (a != c) parent[std::max(a, c)] = std::min(a, c);
   }

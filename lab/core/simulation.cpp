@@ -499,6 +499,13 @@ void Simulation<D>::rebuild() {
   ++C.rebuilds;
 }
 
+template <int D>
+void Simulation<D>::placeWall(std::size_t i, const V& point) {
+  walls_.at(i).point = point;
+  contacts_.valid = false;
+  forces_valid_ = false;
+}
+
 // Reorders the particles along the cell grid (memory order follows space) and everything
 // indexed by them: the bonds' particle indices and the damping forces.
 template <int D>
@@ -520,6 +527,9 @@ void Simulation<D>::sortAlongGrid() {
         BondLoad<D>& l = bonds_.load[b];
         l.fs = -l.fs;
         l.mb = -l.mb;
+        if (!bonds_.face[b].empty()) {
+          bonds_.face[b].swapSides(bond_kinds_[bonds_.kind[b]].template faceLayout<D>());
+        }
       }
       bonds_.i[b] = a;
       bonds_.j[b] = c;

@@ -184,6 +184,10 @@ class Simulation {
   const ParticleStore<D>& particles() const { return particles_; }
   std::size_t addWall(Wall<D> w);
   Wall<D>& wall(std::size_t i) { return walls_.at(i); }
+  // Moves a wall to a new point at once (a rig placing its platens); the contacts are found
+  // anew before the next step. No work is booked: place a wall only where it presses on
+  // nothing, as a platen brought to touch a specimen.
+  void placeWall(std::size_t i, const V& point);
   const Wall<D>& wall(std::size_t i) const { return walls_.at(i); }
   const std::vector<Wall<D>>& walls() const { return walls_; }
   const MaterialTable& materials() const { return materials_; }
@@ -226,6 +230,11 @@ class Simulation {
   // only particles of one cluster (grain), any other kind only particles of different
   // clusters (or of none); pebbles of one clump are never bonded.
   CementReport cement(std::uint8_t kind, double gap_ratio);
+  // Removes particles and the bonds that hold them (a cut, not a break: nothing is logged
+  // as broken), as a rig cuts a specimen from a formed sample. The others keep their state,
+  // their bonds and contact history; the energy ledger restarts, since what the removed
+  // particles held leaves with them. A pebble of an unbroken clump cannot be removed alone.
+  void removeParticles(const std::vector<ParticleId>& ids);
   const BondStore<D>& bonds() const { return bonds_; }
   // Bonds broken so far of a kind and mode.
   std::uint64_t brokenBonds(std::uint8_t kind, BondBreakMode mode) const;
@@ -304,8 +313,9 @@ class Simulation {
   static Simulation loadCheckpoint(const std::string& path);
   // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle and moment_factor,
   // 5 config.skin_ratio, 6 the applied forces, 7 density scaling (the particles' physical
-  // masses, config.timestep.density_scaling, ledger.mass_scaling).
-  static constexpr std::uint32_t kCheckpointVersion = 7;
+  // masses, config.timestep.density_scaling, ledger.mass_scaling), 8 flat joints (the bond
+  // kinds' model and faces, the bonds' face states).
+  static constexpr std::uint32_t kCheckpointVersion = 8;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };

@@ -1,10 +1,13 @@
-// Simulation: the bond stage. Cementing installs the parallel bonds; each step the bond pass
-// (bond_forces.hpp) adds their forces and records the bonds that broke, which are then logged
-// and removed in bond order (two-phase mutation, house rule 7 in README.md).
+// Simulation: the bond stage. Cementing installs the bonds (parallel bonds or flat joints);
+// each step the bond pass (bond_forces.hpp) adds their forces and records the breaks, which
+// are then logged and the broken bonds removed in bond order (two-phase mutation, house rule
+// 7 in README.md). Cutting a specimen removes particles with their bonds.
 
 #include "lab/core/simulation.hpp"
 
 #include <algorithm>
+#include <string>
+#include <unordered_map>
 
 #include "lab/core/stage_clock.hpp"
 
@@ -14,36 +17,42 @@ template <int D>
 void Simulation<D>::computeBondForces(double dt) {
   const StageClock clock(&stages_[kBonds]);
   auto& P = particles_;
-  BondPass<D> pass{P,  bonds_, dt, threaded(),         config_.threads, config_.bond_breakage,
-                   {}, {},     {}, config_.bond_lanes, &bond_kinds_};
+  BondPass<D> pass{P, bonds_, dt, threaded(), config_.threads, config_.bond_breakage};
+  pass.lanes = config_.bond_lanes;
+  pass.kinds = &bond_kinds_;
   bond_forces_.compute(pass);
-  if (!pass.broken.empty()) {
-    // Second phase: log and remove the broken bonds in bond order.
-    std::vector<std::uint8_t> flag(bonds_.size(), 0);
-    for (std::size_t k = 0; k < pass.broken.size(); ++k) {
-      const std::uint32_t b = pass.broken[k];
-      const std::uint32_t i = bonds_.i[b], j = bonds_.j[b];
+  ledger_.friction += pass.slip_energy;
+  if (pass.broken.empty() && pass.released.empty()) return;
+  // Second phase: log the breaks and remove the broken bonds, in bond order.
+  std::vector<std::uint8_t> flag(bonds_.size(), 0);
+  for (std::size_t k = 0; k < pass.broken.size(); ++k) {
+    const std::uint32_t b = pass.broken[k];
+    const std::uint32_t i = bonds_.i[b], j = bonds_.j[b];
+    if (pass.removes[k]) {
       const auto section = BondSection<D>::of(bonds_.radius[b], P.thickness);
       ledger_.bond_breakage += bondEnergy<D>(section, bonds_.kn[b], bonds_.ks[b], bonds_.load[b]);
-      const V d = P.pos[j] - P.pos[i];
-      const double dist = d.norm();
-      const double overlap = P.radius[i] + P.radius[j] - dist;
-      BondBreak<D> e;
-      e.step = step_;
-      e.time = time_;
-      e.position = P.pos[i] + (P.radius[i] - 0.5 * overlap) / dist * d;
-      e.mode = pass.modes[k];
-      e.a = P.id(i);
-      e.b = P.id(j);
-      e.kind = bonds_.kind[b];
-      e.stress = pass.stresses[k];
-      bond_breaks_.push_back(e);
-      ++broken_counts_[2 * e.kind + (e.mode == BondBreakMode::Shear ? 1 : 0)];
       flag[b] = 1;
+    } else {
+      ledger_.bond_breakage += pass.energies[k];  // a flat joint's element
     }
-    bonds_.removeFlagged(flag);
-    bond_forces_.invalidate();
+    const V d = P.pos[j] - P.pos[i];
+    const double dist = d.norm();
+    const double overlap = P.radius[i] + P.radius[j] - dist;
+    BondBreak<D> e;
+    e.step = step_;
+    e.time = time_;
+    e.position = P.pos[i] + (P.radius[i] - 0.5 * overlap) / dist * d + pass.offsets[k];
+    e.mode = pass.modes[k];
+    e.a = P.id(i);
+    e.b = P.id(j);
+    e.kind = bonds_.kind[b];
+    e.stress = pass.stresses[k];
+    bond_breaks_.push_back(e);
+    ++broken_counts_[2 * e.kind + (e.mode == BondBreakMode::Shear ? 1 : 0)];
   }
+  for (const std::uint32_t b : pass.released) flag[b] = 1;
+  bonds_.removeFlagged(flag);
+  bond_forces_.invalidate();
 }
 
 template <int D>
@@ -78,6 +87,7 @@ CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
     existing.push_back(std::uint64_t{bonds_.i[b]} << 32 | bonds_.j[b]);
   }
   std::sort(existing.begin(), existing.end());
+  const FaceLayout layout = kind.template faceLayout<D>();
   auto draw = [&](double mean, double sd, bool& skip) {
     double s = rng_.normal(mean, sd);
     while (s <= 0.0 && kind.negative == NegativeStrength::Resample) {
@@ -120,6 +130,9 @@ CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
       bonds_.tensile.push_back(tensile);
       bonds_.shear.push_back(shear);
       bonds_.load.push_back(BondLoad<D>{});
+      bonds_.face.push_back(kind.model == BondModel::FlatJoint
+                                ? installFace<D>(layout, (P.pos[j] - P.pos[i]).normalized())
+                                : FaceState<D>{});
       ++report.installed;
     }
   }
@@ -127,11 +140,69 @@ CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
   return report;
 }
 
+template <int D>
+void Simulation<D>::removeParticles(const std::vector<ParticleId>& ids) {
+  auto& P = particles_;
+  std::vector<std::uint8_t> gone(P.size(), 0);
+  for (const ParticleId id : ids) {
+    const std::size_t i = P.index(id);
+    if (P.body[i] != kNoBody && clumps_.alive[P.body[i]]) {
+      throw std::invalid_argument("removeParticles: particle " + std::to_string(id.slot) +
+                                  " is a pebble of an unbroken clump");
+    }
+    gone[i] = 1;
+  }
+  std::vector<std::uint8_t> cut(bonds_.size(), 0);
+  for (std::size_t b = 0; b < bonds_.size(); ++b) cut[b] = gone[bonds_.i[b]] | gone[bonds_.j[b]];
+  bonds_.removeFlagged(cut);
+  // Removing moves particles to other indices: the bonds and the damping of the last step
+  // follow their particles by slot.
+  std::vector<std::uint32_t> slot_i(bonds_.size()), slot_j(bonds_.size());
+  for (std::size_t b = 0; b < bonds_.size(); ++b) {
+    slot_i[b] = P.slot_of[bonds_.i[b]], slot_j[b] = P.slot_of[bonds_.j[b]];
+  }
+  std::unordered_map<std::uint32_t, std::pair<V, A>> damping;
+  for (std::size_t i = 0; i < damp_force_.size(); ++i) {
+    if (!gone[i]) damping.emplace(P.slot_of[i], std::pair{damp_force_[i], damp_torque_[i]});
+  }
+  for (const ParticleId id : ids) {
+    if (id.slot < applied_.size()) applied_[id.slot] = V::Zero();
+    P.remove(id);
+  }
+  for (std::size_t b = 0; b < bonds_.size(); ++b) {
+    std::uint32_t i = static_cast<std::uint32_t>(P.indexOfSlot(slot_i[b]));
+    std::uint32_t j = static_cast<std::uint32_t>(P.indexOfSlot(slot_j[b]));
+    if (i > j) {  // keep i < j, seen from the other particle (as sortAlongGrid does)
+      std::swap(i, j);
+      bonds_.load[b].fs = -bonds_.load[b].fs;
+      bonds_.load[b].mb = -bonds_.load[b].mb;
+      if (!bonds_.face[b].empty()) {
+        bonds_.face[b].swapSides(bond_kinds_[bonds_.kind[b]].template faceLayout<D>());
+      }
+    }
+    bonds_.i[b] = i, bonds_.j[b] = j;
+  }
+  if (!damp_force_.empty()) {
+    damp_force_.assign(P.size(), V::Zero());
+    damp_torque_.assign(P.size(), angZero<A>());
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      const auto it = damping.find(P.slot_of[i]);
+      if (it != damping.end())
+        damp_force_[i] = it->second.first, damp_torque_[i] = it->second.second;
+    }
+  }
+  bond_forces_.invalidate();
+  if (prepared_) rebuild();  // the contact pairs named the old indices; history follows slots
+  forces_valid_ = false;
+  restartEnergyLedger();
+}
+
 #define ROCKLAB_BOND_STAGE(D)                                                           \
   template void Simulation<D>::computeBondForces(double);                               \
   template std::uint8_t Simulation<D>::addBondKind(BondKind);                           \
   template std::uint64_t Simulation<D>::brokenBonds(std::uint8_t, BondBreakMode) const; \
-  template CementReport Simulation<D>::cement(std::uint8_t, double);
+  template CementReport Simulation<D>::cement(std::uint8_t, double);                    \
+  template void Simulation<D>::removeParticles(const std::vector<ParticleId>&);
 ROCKLAB_BOND_STAGE(2)
 ROCKLAB_BOND_STAGE(3)
 #undef ROCKLAB_BOND_STAGE

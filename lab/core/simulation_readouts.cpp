@@ -224,9 +224,19 @@ EnergyReport Simulation<D>::energy() const {
   forEachTouching([&](const Touching& t) {
     e.strain += model_->strainEnergy(t.mi, t.mj, t.overlap, t.shape, t.mstar, t.shear2);
   });
+  std::vector<FaceLayout> layouts;
+  for (const BondKind& k : bond_kinds_) layouts.push_back(k.template faceLayout<D>());
   for (std::size_t b = 0; b < bonds_.size(); ++b) {
-    const auto s = BondSection<D>::of(bonds_.radius[b], P.thickness);
-    e.strain += bondEnergy<D>(s, bonds_.kn[b], bonds_.ks[b], bonds_.load[b]);
+    if (bonds_.face[b].empty()) {
+      const auto s = BondSection<D>::of(bonds_.radius[b], P.thickness);
+      e.strain += bondEnergy<D>(s, bonds_.kn[b], bonds_.ks[b], bonds_.load[b]);
+      continue;
+    }
+    FaceMaterial m;
+    m.radius = bonds_.radius[b], m.thickness = P.thickness;
+    m.kn = bonds_.kn[b], m.ks = bonds_.ks[b];
+    const V n = (P.pos[bonds_.j[b]] - P.pos[bonds_.i[b]]).normalized();
+    e.strain += faceEnergy<D>(layouts[bonds_.kind[b]], m, n, bonds_.face[b]);
   }
   return e;
 }

@@ -94,6 +94,13 @@ std::uint64_t Simulation<D>::stateHash() const {
       h = fnv1a(&l.mb, sizeof l.mb, h);
     }
   }
+  for (const FaceState<D>& f : bonds_.face) {
+    for (const FaceElement<D>& e : f.elements) {
+      h = fnv1a(&e.bonded, sizeof e.bonded, h);
+      h = fnv1a(&e.approach, sizeof e.approach, h);
+      h = fnv1a(e.fs.data(), sizeof(double) * D, h);
+    }
+  }
   for (const auto& w : walls_) {
     h = fnv1a(w.point.data(), sizeof(double) * D, h);
     h = fnv1a(w.velocity.data(), sizeof(double) * D, h);

@@ -81,6 +81,7 @@ PackView<D> FlowCoupling<D>::pack(const Simulation<D>& sim) const {
   }
   const auto& B = sim.bonds();
   for (std::size_t b = 0; b < B.size(); ++b) {
+    if (!B.intact(b)) continue;  // a flat joint broken through: no cement left
     const auto a = index_of_slot.find(B.i[b]), c = index_of_slot.find(B.j[b]);
     if (a == index_of_slot.end() || c == index_of_slot.end()) continue;
     v.bond.push_back({a->second, c->second});

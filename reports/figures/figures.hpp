@@ -34,5 +34,8 @@ std::vector<Figure> envelopeEnsembleFigures(const std::vector<const RunData*>& s
                                             const Paper& paper);
 std::vector<Figure> permeameterFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> ultrasonicFigures(const std::vector<const RunData*>& runs, const Paper& paper);
+std::vector<Figure> brazilianFigures(const std::vector<const RunData*>& runs, const Paper& paper);
+std::vector<Figure> directTensionFigures(const std::vector<const RunData*>& runs,
+                                         const Paper& paper);
 
 }  // namespace rocklab::reports

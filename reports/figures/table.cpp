@@ -7,6 +7,7 @@ const std::vector<FigureEntry>& figureTable() {
       {"oedometer", oedometerFigures},     {"hydrostatic", hydrostaticFigures},
       {"biaxial", biaxialFigures},         {"envelope", envelopeFigures, envelopeEnsembleFigures},
       {"permeameter", permeameterFigures}, {"ultrasonic", ultrasonicFigures},
+      {"brazilian", brazilianFigures},     {"direct_tension", directTensionFigures},
   };
   return table;
 }

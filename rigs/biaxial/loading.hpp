@@ -31,13 +31,8 @@ struct LoadingTest {
                        "axial stress above the confinement the platens keep before loading"});
     f(axial_strain_rate, loading_keys::kAxialStrainRate);
     f(axial_strain_max, loading_keys::kAxialStrainMax);
-    f(stop_after_drop, {"stop_after_drop", units::none, Range::closed(0, 1),
-                        "stop once the deviatoric stress has fallen this fraction below its peak "
-                        "(0: run to axial_strain_max)"});
-    f(stop_after_drop_min_strain,
-      {"stop_after_drop_min_strain", units::none, Range::closed(0, 0.9),
-       "the drop stops the test only past this axial strain: the first grains to break or "
-       "slip under a barely loaded sample make no peak"});
+    f(stop_after_drop, loading_keys::kStopAfterDrop);
+    f(stop_after_drop_min_strain, loading_keys::kStopAfterDropMinStrain);
     boost.fields(f);
   }
   // A test that stops after the peak must get past it: a drop needs room to show.

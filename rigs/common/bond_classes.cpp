@@ -39,7 +39,7 @@ BondClasses bondClasses(const Simulation<D>& sim, std::uint8_t kind, int axis) {
   const auto& B = sim.bonds();
   BondClasses classes;
   for (std::size_t b = 0; b < B.size(); ++b) {
-    if (B.kind[b] != kind) continue;
+    if (B.kind[b] != kind || !B.intact(b)) continue;
     const Vec<D> d = P.pos[B.j[b]] - P.pos[B.i[b]];
     const double c = std::abs(d[axis]) / d.norm();
     const std::uint8_t k = c >= axial_cos ? 0 : c <= lateral_cos ? 2 : 1;
@@ -55,7 +55,7 @@ BondOrientations intactByClass(const Simulation<D>& sim, std::uint8_t kind,
   const auto& B = sim.bonds();
   BondOrientations n;
   for (std::size_t b = 0; b < B.size(); ++b) {
-    if (B.kind[b] != kind) continue;
+    if (B.kind[b] != kind || !B.intact(b)) continue;
     const auto it = reference.find(bondKey(P, B.i[b], B.j[b]));
     if (it == reference.end()) continue;  // installed since (none are, in the rigs)
     n.axial += it->second == 0 ? 1 : 0;

@@ -51,6 +51,21 @@ double LoadingFrame<D>::stress(int axis) const {
 }
 
 template <int D>
+double LoadingFrame<D>::force(int axis) const {
+  return stress(axis) * faceArea(axis);
+}
+
+template <int D>
+void LoadingFrame<D>::place(int axis, double lo, double hi) {
+  for (const auto& [w, at] : {std::pair{2 * axis, lo}, std::pair{2 * axis + 1, hi}}) {
+    Vec<D> p = sim_->wall(w).point;
+    p[axis] = at;
+    sim_->placeWall(w, p);
+  }
+  apply();
+}
+
+template <int D>
 double LoadingFrame<D>::meanStress() const {
   double s = 0.0;
   for (int a = 0; a < D; ++a) s += stress(a);

@@ -98,6 +98,11 @@ class LoadingFrame {
   double length(int axis) const;
   double faceArea(int axis) const;
   double stress(int axis) const;  // Pa, compression positive, mean of the axis's two walls
+  double force(int axis) const;   // N, compression positive, mean of the axis's two walls
+  // Moves the walls of an axis to lo (its lower wall) and hi (its upper), at once: platens
+  // brought to touch a specimen cut from the sample, side walls taken away from it. They
+  // must press on nothing there (Simulation::placeWall).
+  void place(int axis, double lo, double hi);
   double meanStress() const;
   // Strain since the last resetReference(), compression positive.
   double strain(int axis) const;

@@ -17,6 +17,14 @@ inline constexpr Field kAxialStrainRate{"axial_strain_rate_per_s", units::per_s,
 inline constexpr Field kAxialStrainMax{
     "axial_strain_max", units::none, Range::leftOpen(0, 0.9),
     "axial strain since the start of loading at which loading stops"};
+inline constexpr Field kStopAfterDrop{
+    "stop_after_drop", units::none, Range::closed(0, 1),
+    "stop once the load (deviatoric stress, platen force) has fallen this fraction below its "
+    "peak (0: run to axial_strain_max)"};
+inline constexpr Field kStopAfterDropMinStrain{
+    "stop_after_drop_min_strain", units::none, Range::closed(0, 0.9),
+    "the drop stops the test only past this axial strain: the first grains to break or slip "
+    "under a barely loaded sample make no peak"};
 inline constexpr Field kStressMax{"stress_max_MPa", units::MPa, Range::leftOpen(0, 1e5),
                                   "peak stress of the hydrostatic ramp"};
 inline constexpr Field kStressRate{

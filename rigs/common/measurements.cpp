@@ -179,7 +179,11 @@ void warnIfNotQuasiStatic(const Specimen<D>& sp, Recorder& rec, const std::strin
 
 template <int D>
 double inertialNumber(const Specimen<D>& sp, double strain_rate) {
-  const double p = std::abs(sp.frame->meanStress());
+  return inertialNumber(sp, strain_rate, std::abs(sp.frame->meanStress()));
+}
+
+template <int D>
+double inertialNumber(const Specimen<D>& sp, double strain_rate, double p) {
   if (!(p > 0.0)) return INFINITY;
   // The density the forces accelerate: heavier under density scaling.
   const double density = sp.settings.material.grain.density * sp.sim->inertialMassRatio();
@@ -194,7 +198,8 @@ double inertialNumber(const Specimen<D>& sp, double strain_rate) {
   template void recordTimings<D>(Recorder&, const std::vector<const Simulation<D>*>&);             \
   template void warnIfNotQuasiStatic<D>(const Specimen<D>&, Recorder&, const std::string&, double, \
                                         double);                                                   \
-  template double inertialNumber<D>(const Specimen<D>&, double);
+  template double inertialNumber<D>(const Specimen<D>&, double);                                   \
+  template double inertialNumber<D>(const Specimen<D>&, double, double);
 ROCKLAB_MEASUREMENTS(2)
 ROCKLAB_MEASUREMENTS(3)
 #undef ROCKLAB_MEASUREMENTS

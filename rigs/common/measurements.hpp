@@ -43,5 +43,8 @@ void warnIfNotQuasiStatic(const Specimen<D>& sp, Recorder& rec, const std::strin
 // granular test is quasi-static (GDR MiDi 2004; da Cruz et al. 2005).
 template <int D>
 double inertialNumber(const Specimen<D>& sp, double strain_rate);
+// The same at a stress scale p (Pa) of the rig's own: a disk's nominal stress, say.
+template <int D>
+double inertialNumber(const Specimen<D>& sp, double strain_rate, double p);
 
 }  // namespace rocklab::rigs

@@ -156,6 +156,7 @@ const Outputs* rigOutputs(std::string_view rig) {
       {"oedometer", oedometer::outputs},     {"biaxial", biaxial::outputs},
       {"envelope", envelope::outputs},       {"hydrostatic", hydrostatic::outputs},
       {"permeameter", permeameter::outputs}, {"ultrasonic", ultrasonic::outputs},
+      {"brazilian", brazilian::outputs},     {"direct_tension", direct_tension::outputs},
   };
   for (const auto& [name, outputs] : table) {
     if (name == rig) return &outputs();

@@ -79,6 +79,12 @@ const Outputs& outputs();
 namespace ultrasonic {
 const Outputs& outputs();
 }
+namespace brazilian {
+const Outputs& outputs();
+}
+namespace direct_tension {
+const Outputs& outputs();
+}
 
 // A rig's outputs by its name (the rig table's names, rigs/registry.cpp), or nullptr.
 const Outputs* rigOutputs(std::string_view rig);

@@ -8,67 +8,12 @@
 
 #include "lab/core/errors.hpp"
 #include "lab/core/random.hpp"
-#include "tests/support.hpp"
+#include "tests/bonded_pair.hpp"
 
 namespace rocklab {
 namespace {
 
-using V3 = Eigen::Vector3d;
-using V2 = Eigen::Vector2d;
-constexpr double kR = 1e-3, kGap = 2e-6, kModulus = 4e9, kRatio = 0.5, kDt = 1e-7;
-
-BondKind cement(double tensile, double shear, double lambda = 1.0) {
-  BondKind k;
-  k.modulus = kModulus;
-  k.stiffness_ratio = kRatio;
-  k.radius_multiplier = lambda;
-  k.tensile_mean = tensile;
-  k.shear_mean = shear;
-  k.tensile_std = k.shear_std = 0.0;
-  return k;
-}
-
-// Two driven (fixed) particles with a small gap, so that only the bond acts, then bonded.
-template <int D>
-struct BondedPair {
-  Simulation<D> sim;
-  ParticleId a, b;
-  Vec<D> n;
-  explicit BondedPair(const BondKind& kind)
-      : sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), config()) {
-    n = Vec<D>::Zero();
-    n[0] = 1.0;
-    ParticleSpec<D> p;
-    p.radius = kR;
-    p.fixed = true;
-    a = sim.particles().add(p);
-    p.position = (2 * kR + kGap) * n;
-    b = sim.particles().add(p);
-    const auto k = sim.addBondKind(kind);
-    const CementReport r = sim.cement(k, 0.01);
-    EXPECT_EQ(r.installed, 1u);
-  }
-  static SimulationConfig config() {
-    SimulationConfig c = testing::undamped();
-    c.timestep.automatic = false;
-    c.timestep.fixed_dt = kDt;
-    return c;
-  }
-  ParticleStore<D>& P() { return sim.particles(); }
-  // Drives a and b with these velocities and spins for `steps` steps.
-  void drive(const Vec<D>& va, const Vec<D>& vb, const Ang<D>& wa, const Ang<D>& wb, int steps) {
-    for (int s = 0; s < steps; ++s) {
-      P().vel[P().index(a)] = va, P().vel[P().index(b)] = vb;
-      P().spin[P().index(a)] = wa, P().spin[P().index(b)] = wb;
-      sim.step();
-    }
-  }
-  Vec<D> force() { return P().force[P().index(b)]; }
-  Ang<D> torque() { return P().torque[P().index(b)]; }
-  double kn() const { return kModulus / (2 * kR); }
-  double ks() const { return kn() / kRatio; }
-  BondSection<D> section(double lambda = 1.0) const { return BondSection<D>::of(lambda * kR, 1.0); }
-};
+using namespace testing::bonded;
 
 TEST(BondStiffness, Normal3D) {
   BondedPair<3> p(cement(1e11, 1e11));
@@ -319,8 +264,9 @@ TEST(Cementing, StrengthDrawsAndNegativeHandling) {
 
 // A bonded pair whose order in the particle arrays flips (reordering at neighbour rebuilds)
 // keeps its load: compare with a run that never reorders.
+// A flat joint too: its elements are seen in mirror order from the other particle.
 TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
-  auto run = [](bool reorder) {
+  auto run = [](bool reorder, BondModel model) {
     SimulationConfig cfg = testing::undamped();
     cfg.timestep.automatic = false;
     cfg.timestep.fixed_dt = kDt;
@@ -338,7 +284,9 @@ TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
     const auto b = sim.particles().add(p);
     p.position = V3(-1e-2, -1e-2, -1e-2);
     sim.particles().add(p);
-    sim.cement(sim.addBondKind(cement(1e11, 1e11)), 0.01);
+    BondKind kind = cement(1e11, 1e11);
+    kind.model = model;
+    sim.cement(sim.addBondKind(kind), 0.01);
     auto& P = sim.particles();
     auto drive = [&](const V3& va, const V3& vb, const V3& wb, int steps) {
       for (int s = 0; s < steps; ++s) {
@@ -355,11 +303,13 @@ TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
     EXPECT_EQ(reorder, before != (P.index(a) < P.index(b)));
     return std::pair{V3(P.force[P.index(b)]), V3(P.torque[P.index(b)])};
   };
-  const auto [f0, t0] = run(false);
-  const auto [f1, t1] = run(true);
-  ASSERT_GT(f0.norm(), 0.0);
-  EXPECT_LT((f1 - f0).norm(), 1e-9 * f0.norm());
-  EXPECT_LT((t1 - t0).norm(), 1e-9 * t0.norm());
+  for (const BondModel model : {BondModel::Parallel, BondModel::FlatJoint}) {
+    const auto [f0, t0] = run(false, model);
+    const auto [f1, t1] = run(true, model);
+    ASSERT_GT(f0.norm(), 0.0);
+    EXPECT_LT((f1 - f0).norm(), 1e-9 * f0.norm());
+    EXPECT_LT((t1 - t0).norm(), 1e-9 * t0.norm());
+  }
 }
 
 // What a shaken bonded sample ends in, to compare the four-lane bond pass with the scalar one.

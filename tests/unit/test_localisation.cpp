@@ -1,5 +1,5 @@
-// The band detector on synthetic damage: a band of known angle in a uniform background; and
-// bonds counted by their orientation to sigma_1.
+// The band detector on synthetic damage: a band of known angle in a uniform background;
+// bonds counted by their orientation to sigma_1; and a Brazilian disk's fracture located.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 #include "lab/core/random.hpp"
 #include "rigs/common/localisation.hpp"
 #include "rigs/common/specimen.hpp"
+#include "rigs/tensile/crack.hpp"
 #include "tests/support.hpp"
 
 namespace rocklab::rigs {
@@ -216,6 +217,33 @@ TEST(BondOrientations, CountsBondsNearTheAxisAndNearItsNormalPlane) {
   EXPECT_EQ(held.axial, 2u);
   EXPECT_EQ(held.inclined, 1u);
   EXPECT_EQ(held.lateral, 2u);
+}
+
+// A Brazilian disk's fracture (rigs/tensile/crack.hpp): breaks scattered along a line of
+// known angle and offset give that angle and offset back; a round cloud is no line.
+TEST(Fracture, ItsAxisAngleAndOffsetFromTheCentre) {
+  Rng rng(4);
+  const double d = 0.01;  // m, the disk's diameter
+  for (const double angle : {0.0, 15.0, 50.0}) {
+    for (const double offset : {0.0, 0.002}) {
+      std::vector<CrackPoint> pts;
+      const double ux = std::sin(angle * kDeg), uy = std::cos(angle * kDeg);  // along the crack
+      for (int k = 0; k < 400; ++k) {
+        const double s = rng.uniform(-0.45, 0.45) * d, w = rng.uniform(-0.02, 0.02) * d;
+        // A line through (offset, 0) perpendicular to it, shifted across by w.
+        pts.push_back({offset * uy + s * ux + w * uy, -offset * ux + s * uy - w * ux});
+      }
+      const Crack c = crackOf(pts, d);
+      EXPECT_NEAR(c.angle_to_axis_deg, angle, 1.0) << angle << " " << offset;
+      EXPECT_NEAR(c.offset_ratio, offset / d, 0.01) << angle << " " << offset;
+      EXPECT_GT(c.elongation, 5.0);
+      EXPECT_EQ(c.throughCentre(), angle <= 20.0 && offset / d <= 0.1) << angle << " " << offset;
+    }
+  }
+  std::vector<CrackPoint> cloud;
+  for (int k = 0; k < 400; ++k) cloud.push_back({rng.uniform(-1, 1) * d, rng.uniform(-1, 1) * d});
+  EXPECT_LT(crackOf(cloud, d).elongation, 1.5);
+  EXPECT_FALSE(crackOf(cloud, d).throughCentre());
 }
 
 }  // namespace

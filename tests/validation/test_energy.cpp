@@ -108,39 +108,45 @@ TEST(Energy, LedgerClosesWithDampingFrictionAndWalls) {
 }
 
 // A cemented packing squeezed until bonds break: the elastic energy the broken bonds held
-// is booked, and the ledger still closes.
+// is booked, and the ledger still closes; with flat joints too, whose elements break one by
+// one and then slide (their friction booked as the contacts' is).
 TEST(Energy, LedgerClosesWithBondBreaks) {
-  const Packing<3> p = loosePacking(600, 0.40, 14);
-  SimulationConfig cfg;
-  cfg.local_damping = 0.3;
-  cfg.timestep.safety = 0.2;
-  Material m = testing::linearMaterial(0.0, 0.0, 0.4, 0.1);
-  m.modulus = 1e8;
-  Simulation<3> sim(testing::table(m), cfg);
-  for (std::size_t i = 0; i < p.centers.size(); ++i) {
-    testing::addParticle<3>(sim, p.centers[i], p.radii[i], V3::Zero());
+  for (const BondModel model : {BondModel::Parallel, BondModel::FlatJoint}) {
+    const Packing<3> p = loosePacking(600, 0.40, 14);
+    SimulationConfig cfg;
+    cfg.local_damping = 0.3;
+    cfg.timestep.safety = 0.2;
+    Material m = testing::linearMaterial(0.0, 0.0, 0.4, 0.1);
+    m.modulus = 1e8;
+    Simulation<3> sim(testing::table(m), cfg);
+    for (std::size_t i = 0; i < p.centers.size(); ++i) {
+      testing::addParticle<3>(sim, p.centers[i], p.radii[i], V3::Zero());
+    }
+    testing::addBox<3>(sim, p.lo, p.hi);
+    BondKind cement;
+    cement.model = model;
+    cement.modulus = 1e8;
+    cement.stiffness_ratio = 1.0;
+    cement.tensile_mean = cement.shear_mean = 2e5;
+    cement.tensile_std = cement.shear_std = 1e5;
+    sim.cement(sim.addBondKind(cement), 0.05);
+    sim.restartEnergyLedger();
+    ASSERT_GT(sim.bonds().size(), 1000u);
+    for (int w = 0; w < 6; ++w) sim.wall(w).velocity = (w >= 4 ? 0.02 : 0.0) * sim.wall(w).normal;
+    sim.run(30000);
+    const EnergyReport e = sim.energy();
+    const std::uint64_t broken =
+        sim.brokenBonds(0, BondBreakMode::Tensile) + sim.brokenBonds(0, BondBreakMode::Shear);
+    const char* name = model == BondModel::Parallel ? "parallel" : "flat joint";
+    EXPECT_GT(broken, 100u) << name;
+    const double in = e.ledger.initial + e.ledger.boundary_work;
+    EXPECT_GT(e.ledger.bond_breakage, 0.0) << name;
+    EXPECT_LT(std::abs(e.imbalance()) / in, 0.01)
+        << name << ": broken " << broken << " strain " << e.strain << " breakage "
+        << e.ledger.bond_breakage << " friction " << e.ledger.friction << " viscous "
+        << e.ledger.viscous << " local " << e.ledger.local_damping << " walls "
+        << e.ledger.boundary_work;
   }
-  testing::addBox<3>(sim, p.lo, p.hi);
-  BondKind cement;
-  cement.modulus = 1e8;
-  cement.stiffness_ratio = 1.0;
-  cement.tensile_mean = cement.shear_mean = 2e5;
-  cement.tensile_std = cement.shear_std = 1e5;
-  sim.cement(sim.addBondKind(cement), 0.05);
-  sim.restartEnergyLedger();
-  ASSERT_GT(sim.bonds().size(), 1000u);
-  for (int w = 0; w < 6; ++w) sim.wall(w).velocity = (w >= 4 ? 0.02 : 0.0) * sim.wall(w).normal;
-  sim.run(30000);
-  const EnergyReport e = sim.energy();
-  const std::uint64_t broken =
-      sim.brokenBonds(0, BondBreakMode::Tensile) + sim.brokenBonds(0, BondBreakMode::Shear);
-  EXPECT_GT(broken, 100u);
-  const double in = e.ledger.initial + e.ledger.boundary_work;
-  EXPECT_GT(e.ledger.bond_breakage, 0.0);
-  EXPECT_LT(std::abs(e.imbalance()) / in, 0.01)
-      << "broken " << broken << " strain " << e.strain << " breakage " << e.ledger.bond_breakage
-      << " friction " << e.ledger.friction << " viscous " << e.ledger.viscous << " local "
-      << e.ledger.local_damping << " walls " << e.ledger.boundary_work;
 }
 
 TEST(Energy, GravityWorkIsBooked) {

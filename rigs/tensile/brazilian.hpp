@@ -1,0 +1,51 @@
+#pragma once
+// The Brazilian test (diametral compression; ISRM 1978, ASTM D3967): a disk (2D) or a
+// cylinder lying on its side (3D, axis along y) is cut from the formed, cemented sample after
+// its formation stress is relieved, brought between two flat platens and loaded along its
+// diameter at a set rate. Its tensile strength is sigma_t = 2 F_peak / (pi D t), the
+// elastic solution's tensile stress at the centre (Hondros 1959), t the disk's thickness
+// (2D) or the cylinder's length (3D).
+
+#include "rigs/common/loading_keys.hpp"
+#include "rigs/common/outputs.hpp"
+#include "rigs/common/specimen.hpp"
+#include "rigs/tensile/release.hpp"
+
+namespace rocklab::rigs::brazilian {
+
+struct Settings {
+  SpecimenSettings specimen;
+  double unload_to = 0.1 * kMPa;    // Pa: the formation stress relieved to this before the cut
+  double unload_rate = 2e4 * kMPa;  // Pa/s
+  double diameter_ratio = 0.9;      // the disk's diameter over the box's smaller side
+  std::int64_t relax_steps_max = 20000;
+  double axial_strain_rate =
+      0.5;  // 1/s: the platens close by this fraction of the diameter per second
+  double axial_strain_max = 0.05;
+  double stop_after_drop = 0.5;
+  double stop_after_drop_min_strain = 0.001;
+
+  template <class F>
+  void fields(F& f) {
+    f.section("", specimen);
+    auto loading = f.at("loading.");
+    loading(axial_strain_rate, loading_keys::kAxialStrainRate);
+    loading(axial_strain_max, loading_keys::kAxialStrainMax);
+    loading(stop_after_drop, loading_keys::kStopAfterDrop);
+    loading(stop_after_drop_min_strain, loading_keys::kStopAfterDropMinStrain);
+    auto cut = f.at("cut.");
+    cut(diameter_ratio, {"diameter_ratio", units::none, Range::leftOpen(0, 1),
+                         "the disk's diameter over the box's smaller side in the loading plane"});
+    auto release = f.at("release.");
+    release(unload_to, tensile::kUnloadTo);
+    release(unload_rate, tensile::kUnloadRate);
+    release(relax_steps_max, tensile::kRelaxStepsMax);
+  }
+  // The disk must hold some particles across (a diameter of at least 10 mean diameters is
+  // checked when it is cut); clumps cannot be cut through.
+  void validate() const;
+};
+
+void run(const Settings& s, Recorder& rec, RunControl& control);
+
+}  // namespace rocklab::rigs::brazilian

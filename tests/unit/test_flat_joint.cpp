@@ -1,0 +1,317 @@
+// The flat-jointed bond (Potyondy 2012; flat_joint.hpp) against hand calculations: the face's
+// elements tile it and add up to its section, an intact face is the parallel bond of the
+// same section in every mode, each element breaks at its strength on its centroid's stress,
+// a partly broken face still bends with the stiffness of its bonded elements, broken
+// elements carry compression and friction but no tension, and the four-lane and threaded bond
+// passes give the same bits with flat joints among the bonds.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "lab/core/errors.hpp"
+#include "lab/core/random.hpp"
+#include "tests/bonded_pair.hpp"
+
+namespace rocklab {
+namespace {
+
+using namespace testing::bonded;
+constexpr double kPi = std::numbers::pi;
+
+BondKind joint(double tensile, double cohesion, int radial, int circumferential = 1) {
+  BondKind k = cement(tensile, cohesion);
+  k.model = BondModel::FlatJoint;
+  k.flat_joint_radial = radial;
+  k.flat_joint_circumferential = circumferential;
+  return k;
+}
+
+// Sums over the elements: area, first moments and second moments about the face's centre
+// (parallel axis theorem: an element's own about its centroid plus A times the arm squared).
+struct FaceSums {
+  double area = 0, x = 0, y = 0, xx = 0, yy = 0, xy = 0;
+  explicit FaceSums(const FaceLayout& L) {
+    for (const FaceElementShape& e : L.elements) {
+      area += e.area, x += e.area * e.x, y += e.area * e.y;
+      xx += e.ixx + e.area * e.x * e.x;
+      yy += e.iyy + e.area * e.y * e.y;
+      xy += e.ixy + e.area * e.x * e.y;
+    }
+  }
+};
+
+TEST(FlatJointFace, ElementsTileTheFaceAndAddUpToItsSection) {
+  for (int n : {1, 2, 3, 5}) {  // 2D: a face 2 long (radius 1): area 2, I = 2 / 3
+    const FaceSums s(FaceLayout::of2D(n));
+    EXPECT_NEAR(s.area, 2.0, 1e-14) << n;
+    EXPECT_NEAR(s.x, 0.0, 1e-14) << n;
+    EXPECT_NEAR(s.xx, 2.0 / 3.0, 1e-14) << n;
+  }
+  for (auto [rings, sectors] : {std::pair{1, 1}, {1, 3}, {2, 4}, {3, 5}}) {
+    // 3D: a disk of radius 1: area pi, I = pi / 4 about any diameter, no product moment.
+    const FaceSums s(FaceLayout::of3D(rings, sectors));
+    EXPECT_NEAR(s.area, kPi, 1e-13) << rings << "x" << sectors;
+    EXPECT_NEAR(s.x, 0.0, 1e-13);
+    EXPECT_NEAR(s.y, 0.0, 1e-13);
+    EXPECT_NEAR(s.xx, kPi / 4, 1e-13) << rings << "x" << sectors;
+    EXPECT_NEAR(s.yy, kPi / 4, 1e-13) << rings << "x" << sectors;
+    EXPECT_NEAR(s.xy, 0.0, 1e-13) << rings << "x" << sectors;
+  }
+  // One ring of three sectors: sector 0 spans 0..120 deg, its centroid at 60 deg and
+  // 2 sin(60) / (3 pi / 3) = sqrt(3) / pi from the centre, its area pi / 3.
+  const FaceLayout three = FaceLayout::of3D(1, 3);
+  EXPECT_NEAR(three.elements[0].area, kPi / 3, 1e-15);
+  EXPECT_NEAR(std::hypot(three.elements[0].x, three.elements[0].y), std::sqrt(3.0) / kPi, 1e-15);
+  EXPECT_NEAR(std::atan2(three.elements[0].y, three.elements[0].x), kPi / 3, 1e-14);
+  // Seen from the other particle: 2D the order reverses; 3D each ring's angles turn over.
+  const FaceLayout four = FaceLayout::of2D(4);
+  EXPECT_EQ(four.mirror(0), 3u);
+  EXPECT_EQ(four.mirror(1), 2u);
+  const FaceLayout rings = FaceLayout::of3D(2, 3);
+  EXPECT_EQ(rings.mirror(0), 2u);
+  EXPECT_EQ(rings.mirror(1), 1u);
+  EXPECT_EQ(rings.mirror(3), 5u);
+  EXPECT_NEAR(rings.elements[rings.mirror(4)].y, -rings.elements[4].y, 1e-15);
+}
+
+// Intact, a flat joint is the parallel bond of its section in every mode (the formulas of
+// test_bonds.cpp's BondStiffness tests): its elements' stiffnesses add up to the face's.
+TEST(FlatJointStiffness, AnIntactFaceIsTheParallelBondIn3D) {
+  const double v = 0.01, w = 10.0;
+  const auto kind = joint(1e11, 1e11, 2, 3);
+  {
+    BondedPair<3> p(kind);
+    p.drive(V3::Zero(), v * p.n, V3::Zero(), V3::Zero(), 100);
+    EXPECT_NEAR(p.force().x(), -p.kn() * p.section().area * 100 * v * kDt, 1e-9 * p.force().norm());
+    EXPECT_NEAR(p.force().y(), 0.0, 1e-9 * p.force().norm());
+  }
+  {
+    BondedPair<3> p(kind);
+    p.drive(V3::Zero(), V3(0, v, 0), V3::Zero(), V3::Zero(), 100);
+    EXPECT_NEAR(p.force().y(), -p.ks() * p.section().area * 100 * v * kDt, 1e-3 * p.force().norm());
+  }
+  for (int axis : {1, 2}) {  // bending about y and z: the face is isotropic
+    BondedPair<3> p(kind);
+    const V3 spin = w * V3::Unit(axis);
+    p.drive(V3::Zero(), V3::Zero(), -spin, spin, 100);
+    const double theta = 2 * w * 100 * kDt;
+    EXPECT_NEAR(p.torque()[axis], -p.kn() * p.section().inertia * theta, 1e-9 * p.torque().norm());
+    EXPECT_LT(p.force().norm(), 1e-9 * p.torque().norm() / kR);
+  }
+  {
+    BondedPair<3> p(kind);
+    p.drive(V3::Zero(), V3::Zero(), V3(-w, 0, 0), V3(w, 0, 0), 100);
+    EXPECT_NEAR(p.torque().x(), -p.ks() * p.section().polar * 2 * w * 100 * kDt,
+                1e-9 * p.torque().norm());
+  }
+}
+
+TEST(FlatJointStiffness, AnIntactFaceIsTheParallelBondIn2D) {
+  const double v = 0.01, w = 10.0;
+  const auto kind = joint(1e11, 1e11, 3);
+  {
+    BondedPair<2> p(kind);
+    p.drive(V2::Zero(), V2(v, 0), 0.0, 0.0, 100);
+    EXPECT_NEAR(p.force().x(), -p.kn() * 2 * kR * 100 * v * kDt, 1e-9 * p.force().norm());
+  }
+  {
+    BondedPair<2> p(kind);
+    p.drive(V2::Zero(), V2(0, v), 0.0, 0.0, 100);
+    EXPECT_NEAR(p.force().y(), -p.ks() * 2 * kR * 100 * v * kDt, 1e-3 * p.force().norm());
+  }
+  {
+    BondedPair<2> p(kind);
+    p.drive(V2::Zero(), V2::Zero(), -w, w, 100);
+    const double inertia = 2 * kR * kR * kR / 3;
+    EXPECT_NEAR(p.torque(), -p.kn() * inertia * 2 * w * 100 * kDt, 1e-9 * std::abs(p.torque()));
+  }
+}
+
+// Pulled apart, every element carries -Fn / A = kn * stretch and all break in the step that
+// reaches the tensile strength; broken and apart, the face goes and nothing holds the pair.
+TEST(FlatJointBreaks, InTensionEveryElementBreaksAtTheStrengthAndTheFaceGoes) {
+  const double strength = 8e6, v = 0.01;
+  BondedPair<3> p(joint(strength, 1e11, 2, 3));
+  const double per_step = p.kn() * v * kDt;
+  int steps = 0;
+  while (p.sim.bondBreaks().empty() && steps < 100000) {
+    p.drive(V3::Zero(), v * p.n, V3::Zero(), V3::Zero(), 1);
+    ++steps;
+  }
+  EXPECT_NEAR(steps, std::ceil(strength / per_step), 1);  // rounding may take one more
+  ASSERT_EQ(p.sim.bondBreaks().size(), 6u);
+  const double stretch = steps * v * kDt;
+  for (const auto& b : p.sim.bondBreaks()) {
+    EXPECT_EQ(b.mode, BondBreakMode::Tensile);
+    EXPECT_GE(b.stress, strength);
+    EXPECT_LT(b.stress, strength + 1.0001 * per_step);
+    EXPECT_NEAR(b.position.x(), kR + (kGap + stretch) / 2, 1e-12);  // on the face
+  }
+  EXPECT_EQ(p.sim.brokenBonds(0, BondBreakMode::Tensile), 6u);
+  EXPECT_EQ(p.sim.bonds().size(), 0u);
+  p.drive(V3::Zero(), v * p.n, V3::Zero(), V3::Zero(), 1);
+  EXPECT_EQ(p.force().norm(), 0.0);
+}
+
+// 2D, two elements with centroids at -R/2 and +R/2. Bent by theta, the element on the
+// stretched side carries kn theta R / 2: it breaks at theta = 2 sigma_t / (kn R), twice the
+// rotation that breaks the parallel bond (peripheral stress kn theta R). The face then still
+// bends, by its bonded element alone: kn (A x^2 + I_e) = kn (R^3 / 4 + R^3 / 12) t, half the
+// intact face's 2 R^3 t / 3. Bent back, the broken element closes and carries compression.
+TEST(FlatJointBreaks, APartlyBrokenFaceStillBendsWithItsBondedElements) {
+  const double strength = 8e6, w = 10.0;
+  BondedPair<2> p(joint(strength, 1e11, 2));
+  const double per_step = p.kn() * (kR / 2) * 2 * w * kDt;
+  int steps = 0;
+  while (p.sim.bondBreaks().empty() && steps < 100000) {
+    p.drive(V2::Zero(), V2::Zero(), -w, w, 1);
+    ++steps;
+  }
+  EXPECT_NEAR(steps, std::ceil(strength / per_step), 1);
+  ASSERT_EQ(p.sim.bondBreaks().size(), 1u);
+  const auto& b = p.sim.bondBreaks()[0];
+  EXPECT_EQ(b.mode, BondBreakMode::Tensile);
+  EXPECT_GE(b.stress, strength);
+  EXPECT_LT(b.stress, strength + 1.0001 * per_step);
+  // j turns anticlockwise: the gap opens below the line of centres (the face's -R/2).
+  EXPECT_NEAR(b.position.y(), -kR / 2, 1e-12);
+  ASSERT_EQ(p.sim.bonds().size(), 1u);
+  EXPECT_TRUE(p.sim.bonds().intact(0));
+  EXPECT_FALSE(p.sim.bonds().face[0].elements[0].bonded);
+
+  const double before = p.torque();
+  p.drive(V2::Zero(), V2::Zero(), -w, w, 10);
+  const double bonded_element = kR * kR * kR / 4 + kR * kR * kR / 12;  // t = 1
+  EXPECT_NEAR(p.torque() - before, -p.kn() * bonded_element * 2 * w * 10 * kDt,
+              1e-9 * std::abs(p.torque()));
+  EXPECT_EQ(p.sim.bondBreaks().size(), 1u);
+
+  // Back past the unbent state: the broken element's surfaces meet again at theta = its
+  // stretch at the break, then it pushes (compression), never pulls.
+  FaceElement<2> broken = p.sim.bonds().face[0].elements[0];
+  EXPECT_LT(broken.approach, 0.0);
+  p.drive(V2::Zero(), V2::Zero(), w, -w, steps + 10 + 20);
+  broken = p.sim.bonds().face[0].elements[0];
+  EXPECT_GT(broken.approach, 0.0);
+  const FaceElement<2>& bonded = p.sim.bonds().face[0].elements[1];
+  EXPECT_TRUE(bonded.bonded);
+  // Now both elements push back against the reversed bend: the torque on j is positive and
+  // is the bonded element's kn (A x^2 + I_e) theta plus the broken one's kn A approach R / 2.
+  const double theta = -20 * 2 * w * kDt;  // net rotation of j relative to i
+  const double expected = -p.kn() * bonded_element * theta + p.kn() * kR * broken.approach * kR / 2;
+  EXPECT_GT(p.torque(), 0.0);
+  EXPECT_NEAR(p.torque(), expected, 1e-6 * std::abs(expected));
+}
+
+// Sheared under a compressive normal stress sigma = kn * approach, a bonded element breaks at
+// c + sigma tan(phi), and under tension at c - |sigma| tan(phi) (PFC's flat joint: tension
+// lowers the shear strength). Broken, the face slides: its shear force is mu times its normal
+// force; pulled apart, it goes without another break.
+TEST(FlatJointBreaks, InShearAtCohesionPlusFrictionThenTheBrokenFaceSlides) {
+  const double c = 2e6, phi = 40.0 * kPi / 180.0, mu = 0.5, v = 0.01;
+  for (const double approach : {0.5e-6, -0.2e-6}) {
+    BondKind kind = joint(1e11, c, 2);
+    kind.friction_angle = phi;
+    kind.flat_joint_friction = mu;
+    BondedPair<2> p(kind);
+    const int load_steps = 1000;
+    p.drive(V2::Zero(), -approach / (load_steps * kDt) * p.n, 0.0, 0.0, load_steps);
+    const double sigma = p.kn() * approach;
+    const double strength = c + sigma * std::tan(phi);
+    std::size_t steps = 0;
+    while (p.sim.bondBreaks().empty() && steps < 100000) {
+      p.drive(V2::Zero(), V2(0, v), 0.0, 0.0, 1);
+      ++steps;
+    }
+    ASSERT_EQ(p.sim.bondBreaks().size(), 2u) << "approach " << approach;
+    for (const auto& b : p.sim.bondBreaks()) {
+      EXPECT_EQ(b.mode, BondBreakMode::Shear);
+      // The normal turns as j slides (by 4e-4 rad here): sigma moves by about 200 Pa.
+      EXPECT_GE(b.stress, strength * (1 - 5e-4));
+      EXPECT_LT(b.stress, strength + 1.01 * p.ks() * v * kDt) << "approach " << approach;
+    }
+    if (approach < 0) {
+      // Broken under tension: no normal force, so no friction either; the face is apart.
+      EXPECT_EQ(p.sim.bonds().size(), 0u);
+      continue;
+    }
+    ASSERT_EQ(p.sim.bonds().size(), 1u);
+    EXPECT_FALSE(p.sim.bonds().intact(0));
+    p.drive(V2::Zero(), V2(0, v), 0.0, 0.0, 50);
+    const double fn = p.kn() * 2 * kR * approach;  // both elements, t = 1
+    const V2 n = (p.P().pos[p.P().index(p.b)] - p.P().pos[p.P().index(p.a)]).normalized();
+    const double normal = p.force().dot(n);
+    EXPECT_NEAR(normal, fn, 1e-3 * fn);
+    EXPECT_NEAR((p.force() - normal * n).norm(), mu * normal, 1e-9 * fn);
+    // Pulled apart by twice the approach: the face goes, no break is logged for it.
+    p.drive(V2::Zero(), 2 * approach / (100 * kDt) * p.n, 0.0, 0.0, 100);
+    EXPECT_EQ(p.sim.bonds().size(), 0u);
+    EXPECT_EQ(p.sim.bondBreaks().size(), 2u);
+  }
+}
+
+// What a shaken sample of flat joints and parallel bonds ends in.
+struct Outcome {
+  std::vector<V3> pos;
+  std::vector<double> stresses;
+  std::uint64_t hash = 0;
+};
+
+// Flat joints among parallel bonds: the four-lane pass (which sends each flat joint down the
+// scalar path) on two threads gives the bits of bonds one at a time on one.
+TEST(FlatJointPass, LanesAndThreadsGiveTheSerialBitsWithJointsAmongTheBonds) {
+  auto run = [](bool lanes, int threads) {
+    SimulationConfig cfg = testing::undamped();
+    cfg.timestep.automatic = false;
+    cfg.timestep.fixed_dt = kDt;
+    cfg.bond_lanes = lanes;
+    cfg.threads = threads;
+    Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), cfg);
+    Rng rng(11);
+    for (int x = 0; x < 7; ++x) {
+      for (int y = 0; y < 5; ++y) {
+        for (int z = 0; z < 4; ++z) {
+          const V3 jitter(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+          testing::addParticle<3>(sim, V3(2 * kR * V3(x, y, z) + 0.02 * kR * jitter),
+                                  kR * rng.uniform(0.98, 1.02), V3::Zero());
+        }
+      }
+    }
+    // Joints on the closest pairs, parallel bonds on the rest.
+    const auto joints = sim.addBondKind(joint(2e6, 3e6, 2, 3));
+    EXPECT_GT(sim.cement(joints, 0.01).installed, 20u);
+    EXPECT_GT(sim.cement(sim.addBondKind(cement(2e6, 3e6)), 0.1).installed, 100u);
+    auto& P = sim.particles();
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      P.vel[i] = 0.05 * V3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+      P.spin[i] = 50 * V3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    }
+    for (int s = 0; s < 400; ++s) sim.step();
+    Outcome o;
+    for (const auto& b : sim.bondBreaks()) o.stresses.push_back(b.stress);
+    for (std::size_t i = 0; i < P.size(); ++i) o.pos.push_back(P.pos[i]);
+    o.hash = sim.stateHash();
+    EXPECT_GT(sim.brokenBonds(joints, BondBreakMode::Tensile), 0u);
+    EXPECT_GT(sim.brokenBonds(joints, BondBreakMode::Shear), 0u);
+    return o;
+  };
+  const Outcome serial = run(false, 1), fast = run(true, 2);
+  EXPECT_GT(serial.stresses.size(), 10u);
+  EXPECT_EQ(fast.stresses, serial.stresses);
+  EXPECT_EQ(fast.pos, serial.pos);
+  EXPECT_EQ(fast.hash, serial.hash);
+}
+
+TEST(FlatJoint, KindsAreValidated) {
+  Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), testing::undamped());
+  BondKind k = joint(8e6, 8e6, 2, 3);
+  k.moment_factor = 0.5;  // applies to parallel bonds only
+  EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
+  k = joint(8e6, 8e6, 0, 3);
+  EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
+}
+
+}  // namespace
+}  // namespace rocklab
