@@ -4,7 +4,6 @@
 #include <numbers>
 
 #include "lab/core/errors.hpp"
-#include "rigs/common/formation.hpp"
 #include "rigs/common/measurements.hpp"
 #include "rigs/tensile/crack.hpp"
 #include "rigs/tensile/release.hpp"
@@ -12,8 +11,7 @@
 namespace rocklab::rigs::brazilian {
 
 void Settings::validate() const {
-  tensile::validateRelease(specimen, unload_to,
-                           {axial_strain_max, stop_after_drop, stop_after_drop_min_strain});
+  tensile::validate(specimen, release, loading);
 }
 
 namespace {
@@ -120,14 +118,13 @@ LoadingHistory load(Specimen<D>& sp, const Settings& s, const Disk<D>& disk, Rec
   Journal::Unit unit = control.unit(stage);
   if (unit.done(h, sp)) return h;
   seatPlatens(sp);  // at the relaxed disk: what it pushed on them while relaxing is let go
-  frame.set(ax, Axis{Mode::StrainRate, s.axial_strain_rate});
+  frame.set(ax, Axis{Mode::StrainRate, s.loading.axial_strain_rate});
   frame.resetReference();
   sp.resetBrokenCount();
   h.start_step = sim.steps();
   h.watch.breaks_at_peak = sim.bondBreaks().size();
   unit.resume(h, sp);
   const double to_stress = 2.0 / (std::numbers::pi * disk.diameter * disk.thickness);
-  const tensile::DropRule rule{s.axial_strain_max, s.stop_after_drop, s.stop_after_drop_min_strain};
   for (bool done = false; !done;) {
     unit.tick(h, sp);
     frame.step();
@@ -136,9 +133,9 @@ LoadingHistory load(Specimen<D>& sp, const Settings& s, const Disk<D>& disk, Rec
     const bool new_peak = h.watch.see(sp, force, closure);
     if (new_peak) {
       // At the peak, the disk's own stress scale: its nominal stress 2F / (pi D t).
-      h.inertial_at_peak = inertialNumber(sp, s.axial_strain_rate, force * to_stress);
+      h.inertial_at_peak = inertialNumber(sp, s.loading.axial_strain_rate, force * to_stress);
     }
-    done = h.watch.ends(force, closure, sim.bondBreaks().size(), rule);
+    done = h.watch.ends(force, closure, sim.bondBreaks().size(), s.loading);
     if (h.watch.recordDue(steps, sim.steps(), record_every, new_peak, done)) {
       auto put = [&](const std::string& name, double v) {
         rec.series(name, sim.steps(), sim.time(), v);
@@ -153,7 +150,7 @@ LoadingHistory load(Specimen<D>& sp, const Settings& s, const Disk<D>& disk, Rec
       snapshot(sp, rec, stage, "step " + std::to_string(steps));
     }
     if (steps % 200 == 0) {
-      control.tick(stage, sim.steps(), closure / s.axial_strain_max,
+      control.tick(stage, sim.steps(), closure / s.loading.axial_strain_max,
                    "F " + fmt(force) + " N at diametral strain " + fmt(closure));
     }
   }
@@ -200,15 +197,10 @@ void recordResults(const Specimen<D>& sp, const Disk<D>& disk, const LoadingHist
 
 template <int D>
 void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
-  Specimen<D> sp = buildSpecimen<D>(s.specimen, control);
-  rec.result("particles", static_cast<double>(sp.sim->particles().size()), "");
-  formAndCement(sp, rec, control);
-  servoTo(sp, s.unload_to, s.unload_to, s.unload_rate, "unloading", rec, control);
-  recordBreaks(sp, rec, "unloading");
+  Specimen<D> sp = tensile::formAndUnload<D>(s.specimen, s.release, rec, control);
   const Disk<D> disk = cutDisk(sp, s, rec);
   snapshot(sp, rec, "cut", "disk");
-  tensile::relax(sp, s.relax_steps_max, rec, control);
-  recordBreaks(sp, rec, "relaxation");  // the breaks the release made are the relaxation's
+  tensile::relax(sp, s.release.relax_steps_max, rec, control);
   const LoadingHistory h = load(sp, s, disk, rec, control);
   recordResults(sp, disk, h, rec);
   recordTimings<D>(rec, {sp.sim.get()});

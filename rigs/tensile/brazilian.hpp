@@ -15,31 +15,18 @@ namespace rocklab::rigs::brazilian {
 
 struct Settings {
   SpecimenSettings specimen;
-  double unload_to = 0.1 * kMPa;    // Pa: the formation stress relieved to this before the cut
-  double unload_rate = 2e4 * kMPa;  // Pa/s
-  double diameter_ratio = 0.9;      // the disk's diameter over the box's smaller side
-  std::int64_t relax_steps_max = 20000;
-  double axial_strain_rate =
-      0.5;  // 1/s: the platens close by this fraction of the diameter per second
-  double axial_strain_max = 0.05;
-  double stop_after_drop = 0.5;
-  double stop_after_drop_min_strain = 0.001;
+  tensile::Release release;
+  tensile::Loading loading{0.5, 0.05, 0.5, 0.001};
+  double diameter_ratio = 0.9;  // the disk's diameter over the box's smaller side
 
   template <class F>
   void fields(F& f) {
     f.section("", specimen);
-    auto loading = f.at("loading.");
-    loading(axial_strain_rate, loading_keys::kAxialStrainRate);
-    loading(axial_strain_max, loading_keys::kAxialStrainMax);
-    loading(stop_after_drop, loading_keys::kStopAfterDrop);
-    loading(stop_after_drop_min_strain, loading_keys::kStopAfterDropMinStrain);
+    f.section("loading.", loading);
+    f.section("release.", release);
     auto cut = f.at("cut.");
     cut(diameter_ratio, {"diameter_ratio", units::none, Range::leftOpen(0, 1),
                          "the disk's diameter over the box's smaller side in the loading plane"});
-    auto release = f.at("release.");
-    release(unload_to, tensile::kUnloadTo);
-    release(unload_rate, tensile::kUnloadRate);
-    release(relax_steps_max, tensile::kRelaxStepsMax);
   }
   // The disk must hold some particles across (a diameter of at least 10 mean diameters is
   // checked when it is cut); clumps cannot be cut through.

@@ -4,15 +4,13 @@
 #include <cmath>
 
 #include "lab/core/errors.hpp"
-#include "rigs/common/formation.hpp"
 #include "rigs/common/measurements.hpp"
 #include "rigs/tensile/crack.hpp"
 
 namespace rocklab::rigs::direct_tension {
 
 void Settings::validate() const {
-  tensile::validateRelease(specimen, unload_to,
-                           {axial_strain_max, stop_after_drop, stop_after_drop_min_strain});
+  tensile::validate(specimen, release, loading);
 }
 
 namespace {
@@ -118,14 +116,13 @@ PullHistory pull(Specimen<D>& sp, const Settings& s, const Grips& g, Recorder& r
   PullHistory h;
   Journal::Unit unit = control.unit(stage);
   if (unit.done(h, sp)) return h;
-  const double speed = 0.5 * s.axial_strain_rate * g.gauge;
+  const double speed = 0.5 * s.loading.axial_strain_rate * g.gauge;
   sim.setDrivenVelocity(g.bottom, -speed * Vec<D>::Unit(ax));
   sim.setDrivenVelocity(g.top, speed * Vec<D>::Unit(ax));
   sp.resetBrokenCount();
   h.start_step = sim.steps();
   h.watch.breaks_at_peak = sim.bondBreaks().size();
   unit.resume(h, sp);
-  const tensile::DropRule rule{s.axial_strain_max, s.stop_after_drop, s.stop_after_drop_min_strain};
   for (bool done = false; !done;) {
     unit.tick(h, sp);
     sp.frame->step();
@@ -134,8 +131,8 @@ PullHistory pull(Specimen<D>& sp, const Settings& s, const Grips& g, Recorder& r
     const double force = 0.5 * (layerPull(sim, g.top, 1.0) + layerPull(sim, g.bottom, -1.0));
     const double stress = force / g.area;
     const bool new_peak = h.watch.see(sp, stress, strain);
-    if (new_peak) h.inertial_at_peak = inertialNumber(sp, s.axial_strain_rate, stress);
-    done = h.watch.ends(stress, strain, sim.bondBreaks().size(), rule);
+    if (new_peak) h.inertial_at_peak = inertialNumber(sp, s.loading.axial_strain_rate, stress);
+    done = h.watch.ends(stress, strain, sim.bondBreaks().size(), s.loading);
     if (h.watch.recordDue(steps, sim.steps(), record_every, new_peak, done)) {
       auto put = [&](const std::string& name, double v) {
         rec.series(name, sim.steps(), sim.time(), v);
@@ -151,7 +148,7 @@ PullHistory pull(Specimen<D>& sp, const Settings& s, const Grips& g, Recorder& r
       snapshot(sp, rec, stage, "step " + std::to_string(steps));
     }
     if (steps % 200 == 0) {
-      control.tick(stage, sim.steps(), strain / s.axial_strain_max,
+      control.tick(stage, sim.steps(), strain / s.loading.axial_strain_max,
                    "sigma " + fmt(stress / 1e6) + " MPa at axial strain " + fmt(strain));
     }
   }
@@ -214,14 +211,9 @@ void recordResults(const Specimen<D>& sp, const Grips& g, const PullHistory& h, 
 
 template <int D>
 void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
-  Specimen<D> sp = buildSpecimen<D>(s.specimen, control);
-  rec.result("particles", static_cast<double>(sp.sim->particles().size()), "");
-  formAndCement(sp, rec, control);
-  servoTo(sp, s.unload_to, s.unload_to, s.unload_rate, "unloading", rec, control);
-  recordBreaks(sp, rec, "unloading");
+  Specimen<D> sp = tensile::formAndUnload<D>(s.specimen, s.release, rec, control);
   const Grips g = glue(sp, s, rec);
-  tensile::relax(sp, s.relax_steps_max, rec, control);
-  recordBreaks(sp, rec, "relaxation");  // the breaks the release made are the relaxation's
+  tensile::relax(sp, s.release.relax_steps_max, rec, control);
   const PullHistory h = pull(sp, s, g, rec, control);
   recordResults(sp, g, h, rec);
   recordTimings<D>(rec, {sp.sim.get()});

@@ -13,27 +13,15 @@ namespace rocklab::rigs::direct_tension {
 
 struct Settings {
   SpecimenSettings specimen;
-  double unload_to = 0.1 * kMPa;    // Pa
-  double unload_rate = 2e4 * kMPa;  // Pa/s
-  std::int64_t relax_steps_max = 20000;
-  double layer_diameters = 2.0;    // glued layers' thickness, in mean particle diameters
-  double axial_strain_rate = 0.5;  // 1/s
-  double axial_strain_max = 0.02;
-  double stop_after_drop = 0.5;
-  double stop_after_drop_min_strain = 0.0;
+  tensile::Release release;
+  tensile::Loading loading{0.5, 0.02, 0.5, 0.0};
+  double layer_diameters = 2.0;  // glued layers' thickness, in mean particle diameters
 
   template <class F>
   void fields(F& f) {
     f.section("", specimen);
-    auto loading = f.at("loading.");
-    loading(axial_strain_rate, loading_keys::kAxialStrainRate);
-    loading(axial_strain_max, loading_keys::kAxialStrainMax);
-    loading(stop_after_drop, loading_keys::kStopAfterDrop);
-    loading(stop_after_drop_min_strain, loading_keys::kStopAfterDropMinStrain);
-    auto release = f.at("release.");
-    release(unload_to, tensile::kUnloadTo);
-    release(unload_rate, tensile::kUnloadRate);
-    release(relax_steps_max, tensile::kRelaxStepsMax);
+    f.section("loading.", loading);
+    f.section("release.", release);
     auto glue = f.at("glue.");
     glue(layer_diameters,
          {"layer_diameters", units::none, Range::closed(0.5, 20),

@@ -2,13 +2,43 @@
 
 #include "rigs/common/outputs.hpp"
 
-namespace rocklab::rigs::brazilian {
+namespace rocklab::rigs::tensile {
 
+namespace {
+
+// What both tests record: the specimen's, the release and what every loading records
+// (rigs/tensile/release.hpp).
 const Outputs& outputs() {
   static const Outputs o =
       Outputs()
           .add(specimenOutputs())
           .prefixes({"unloading."})
+          .results({
+              {"relaxation_steps", "-", "steps the released specimen settled for"},
+              {"relaxation_unbalanced_force_ratio", "-", "its unbalanced force ratio then"},
+              {"broken_bonds_at_peak", "-", "cement bonds broken in the loading by the peak"},
+              {"broken_bonds_tensile_at_peak", "-", "of them in tension"},
+              {"broken_bonds_shear_at_peak", "-", "of them in shear"},
+              {"broken_bonds_total", "-", "cement bonds broken during the loading"},
+              {"loading_steps", "-", "steps of the loading"},
+              {"mean_unbalanced_force_ratio", "-", "mean unbalanced force ratio of the loading"},
+              {"inertial_number_at_peak", "-",
+               "inertial number at the peak, at the test's stress (a disk's nominal stress)"},
+              {"fracture_breaks", "-", "bonds broken from the peak to the end: the fracture"},
+          });
+  return o;
+}
+
+}  // namespace
+
+}  // namespace rocklab::rigs::tensile
+
+namespace rocklab::rigs::brazilian {
+
+const Outputs& outputs() {
+  static const Outputs o =
+      Outputs()
+          .add(tensile::outputs())
           .series({
               {"platen_force_N", "N", "mean force of the two platens on the disk"},
               {"platen_closure_mm", "mm", "closure of the platens since loading began"},
@@ -22,20 +52,9 @@ const Outputs& outputs() {
               {"disk_thickness_mm", "mm",
                "thickness t: the disks' (2D), the cylinder's length (3D)"},
               {"bonds_in_disk", "-", "bonds left in the disk after the cut"},
-              {"relaxation_steps", "-", "steps the cut disk settled for"},
-              {"relaxation_unbalanced_force_ratio", "-", "its unbalanced force ratio then"},
               {"tensile_strength_MPa", "MPa", "sigma_t = 2 F_peak / (pi D t)"},
               {"peak_force_N", "N", "peak platen force"},
               {"diametral_strain_at_peak", "-", "platen closure over the diameter at the peak"},
-              {"broken_bonds_at_peak", "-", "cement bonds broken in the loading by the peak"},
-              {"broken_bonds_tensile_at_peak", "-", "of them in tension"},
-              {"broken_bonds_shear_at_peak", "-", "of them in shear"},
-              {"broken_bonds_total", "-", "cement bonds broken during the loading"},
-              {"loading_steps", "-", "steps of the loading"},
-              {"mean_unbalanced_force_ratio", "-", "mean unbalanced force ratio of the loading"},
-              {"inertial_number_at_peak", "-",
-               "inertial number at the peak, at the disk's nominal stress"},
-              {"fracture_breaks", "-", "bonds broken from the peak to the end: the fracture"},
               {"fracture_angle_to_loading_deg", "deg",
                "principal axis of the fracture's breaks against the loaded diameter"},
               {"fracture_offset_ratio", "-",
@@ -64,8 +83,7 @@ namespace rocklab::rigs::direct_tension {
 const Outputs& outputs() {
   static const Outputs o =
       Outputs()
-          .add(specimenOutputs())
-          .prefixes({"unloading."})
+          .add(tensile::outputs())
           .series({
               {"pull_force_N", "N", "mean force the specimen pulls its two glued layers back with"},
               {"axial_strain", "-", "extension of the gauge between the glued layers"},
@@ -76,21 +94,11 @@ const Outputs& outputs() {
               {"glued_particles_top", "-", "particles glued to the top platen"},
               {"gauge_length_mm", "mm", "between the glued layers' mean positions"},
               {"cross_section_mm2", "mm^2", "the specimen's cross-section"},
-              {"relaxation_steps", "-", "steps the released specimen settled for"},
-              {"relaxation_unbalanced_force_ratio", "-", "its unbalanced force ratio then"},
               {"tensile_strength_MPa", "MPa", "peak pull force over the cross-section"},
               {"peak_force_N", "N", "peak pull force"},
               {"axial_strain_at_peak", "-", "gauge extension at the peak"},
               {"tensile_modulus_MPa", "MPa",
                "modulus in tension: slope of stress against strain from 10% to 50% of the peak"},
-              {"broken_bonds_at_peak", "-", "cement bonds broken in the loading by the peak"},
-              {"broken_bonds_tensile_at_peak", "-", "of them in tension"},
-              {"broken_bonds_shear_at_peak", "-", "of them in shear"},
-              {"broken_bonds_total", "-", "cement bonds broken during the loading"},
-              {"loading_steps", "-", "steps of the loading"},
-              {"mean_unbalanced_force_ratio", "-", "mean unbalanced force ratio of the loading"},
-              {"inertial_number_at_peak", "-", "inertial number at the peak, at its stress"},
-              {"fracture_breaks", "-", "bonds broken from the peak to the end: the fracture"},
               {"fracture_angle_to_loading_deg", "deg",
                "principal axis of the fracture's breaks against the load (90: across it)"},
               {"fracture_height_ratio", "-",

@@ -1,9 +1,21 @@
 #include "rigs/tensile/release.hpp"
 
 #include "lab/core/errors.hpp"
+#include "rigs/common/formation.hpp"
 #include "rigs/common/measurements.hpp"
 
 namespace rocklab::rigs::tensile {
+
+template <int D>
+Specimen<D> formAndUnload(const SpecimenSettings& s, const Release& release, Recorder& rec,
+                          RunControl& control) {
+  Specimen<D> sp = buildSpecimen<D>(s, control);
+  rec.result("particles", static_cast<double>(sp.sim->particles().size()), "");
+  formAndCement(sp, rec, control);
+  servoTo(sp, release.unload_to, release.unload_to, release.unload_rate, "unloading", rec, control);
+  recordBreaks(sp, rec, "unloading");
+  return sp;
+}
 
 template <int D>
 void clearSides(Specimen<D>& sp) {
@@ -48,6 +60,7 @@ void relax(Specimen<D>& sp, std::int64_t max_steps, Recorder& rec, RunControl& c
   }
   rec.result("relaxation_steps", static_cast<double>(st.done), "");
   rec.result("relaxation_unbalanced_force_ratio", sim.unbalancedForceRatio(), "");
+  recordBreaks(sp, rec, "relaxation");  // the breaks the release made are the relaxation's
   unit.finish(st, sp);
 }
 
@@ -62,11 +75,11 @@ bool PeakWatch::see(const Specimen<D>& sp, double load, double strain) {
   return true;
 }
 
-bool PeakWatch::ends(double load, double strain, std::size_t breaks, const DropRule& rule) const {
-  if (strain >= rule.strain_max) return true;
+bool PeakWatch::ends(double load, double strain, std::size_t breaks, const Loading& rule) const {
+  if (strain >= rule.axial_strain_max) return true;
   const bool cracked = peak > 0.0 && breaks >= breaks_at_peak + 10;
-  return rule.drop > 0.0 && strain >= rule.min_strain && cracked &&
-         load < (1.0 - rule.drop) * peak && strain > peak_strain;
+  return rule.stop_after_drop > 0.0 && strain >= rule.stop_after_drop_min_strain && cracked &&
+         load < (1.0 - rule.stop_after_drop) * peak && strain > peak_strain;
 }
 
 bool PeakWatch::recordDue(std::uint64_t stage_step, std::uint64_t step, std::uint64_t every,
@@ -109,19 +122,19 @@ void recordLoadingResults(const Specimen<D>& sp, const PeakWatch& w, std::uint64
   warnIfNotQuasiStatic(sp, rec, "loading", w.meanUnbalanced(), inertial_at_peak);
 }
 
-void validateRelease(const SpecimenSettings& specimen, double unload_to, const DropRule& rule) {
+void validate(const SpecimenSettings& specimen, const Release& release, const Loading& loading) {
   if (specimen.sample.kind == SampleKind::Clumps) {
     throw InvalidParameter("", "sample.kind",
                            "clumps can be neither cut nor glued (a rigid grain would be cut "
                            "through or held by some of its pebbles): use spheres or grains");
   }
-  if (rule.strain_max <= rule.min_strain) {
+  if (loading.axial_strain_max <= loading.stop_after_drop_min_strain) {
     throw InvalidParameter("", "loading.axial_strain_max",
                            "must exceed loading.stop_after_drop_min_strain: the test must get "
                            "past the strain where a drop may end it");
   }
   const FormationSettings& f = specimen.formation;
-  if (unload_to > std::min(f.axial_stress, f.lateral_stress)) {
+  if (release.unload_to > std::min(f.axial_stress, f.lateral_stress)) {
     throw InvalidParameter("", "release.unload_to_MPa",
                            "must not exceed the formation stresses: the sample is unloaded to it");
   }
@@ -135,6 +148,10 @@ template void recordLoadingResults<2>(const Specimen<2>&, const PeakWatch&, std:
                                       Recorder&);
 template void recordLoadingResults<3>(const Specimen<3>&, const PeakWatch&, std::uint64_t, double,
                                       Recorder&);
+template Specimen<2> formAndUnload<2>(const SpecimenSettings&, const Release&, Recorder&,
+                                      RunControl&);
+template Specimen<3> formAndUnload<3>(const SpecimenSettings&, const Release&, Recorder&,
+                                      RunControl&);
 template void clearSides<2>(Specimen<2>&);
 template void clearSides<3>(Specimen<3>&);
 template void relax<2>(Specimen<2>&, std::int64_t, Recorder&, RunControl&);

@@ -1,23 +1,58 @@
 #pragma once
-// What both tensile tests do to a formed sample before loading it: take it out of its box
-// (every wall fixed, the side walls a box length away) and let it settle once cut or glued.
-// Their shared keys are declared here once.
+// What both tensile tests share: their release and loading keys; taking a formed sample out
+// of its box (every wall fixed, the side walls a box length away) and letting it settle once
+// cut or glued; watching the load for its peak and the end.
 
 #include <algorithm>
 
+#include "rigs/common/loading_keys.hpp"
 #include "rigs/common/specimen.hpp"
 
 namespace rocklab::rigs::tensile {
 
-inline constexpr Field kUnloadTo{"unload_to_MPa", units::MPa, Range::closed(0, 1e5),
-                                 "the formation stress is relieved to this before the specimen "
-                                 "is taken out of the box"};
-inline constexpr Field kUnloadRate{"unload_rate_MPa_per_s", units::MPa_per_s,
-                                   Range::leftOpen(0, 1e12), "stress rate of that unloading"};
-inline constexpr Field kRelaxStepsMax{
-    "relax_steps_max", units::none, Range::closed(0, 1e9),
-    "out of the box, the specimen settles until its unbalanced force ratio is below "
-    "formation.unbalanced_force_ratio, at most this many steps"};
+// The release (`release.*`): the formation stress relieved, the specimen settled once out
+// of its box.
+struct Release {
+  double unload_to = 0.1 * kMPa;    // Pa
+  double unload_rate = 2e4 * kMPa;  // Pa/s
+  std::int64_t relax_steps_max = 20000;
+
+  template <class F>
+  void fields(F& f) {
+    f(unload_to, {"unload_to_MPa", units::MPa, Range::closed(0, 1e5),
+                  "the formation stress is relieved to this before the specimen is taken out "
+                  "of the box"});
+    f(unload_rate, {"unload_rate_MPa_per_s", units::MPa_per_s, Range::leftOpen(0, 1e12),
+                    "stress rate of that unloading"});
+    f(relax_steps_max,
+      {"relax_steps_max", units::none, Range::closed(0, 1e9),
+       "out of the box, the specimen settles until its unbalanced force ratio is below "
+       "formation.unbalanced_force_ratio, at most this many steps"});
+  }
+};
+
+// The loading (`loading.*`): its rate and when it ends (PeakWatch::ends). Each rig gives
+// its own defaults.
+struct Loading {
+  double axial_strain_rate = 0.5;  // 1/s
+  double axial_strain_max = 0.05;
+  double stop_after_drop = 0.5;
+  double stop_after_drop_min_strain = 0.0;
+
+  template <class F>
+  void fields(F& f) {
+    f(axial_strain_rate, loading_keys::kAxialStrainRate);
+    f(axial_strain_max, loading_keys::kAxialStrainMax);
+    f(stop_after_drop, loading_keys::kStopAfterDrop);
+    f(stop_after_drop_min_strain, loading_keys::kStopAfterDropMinStrain);
+  }
+};
+
+// Builds, forms and cements the sample and relieves its formation stress (stage
+// `unloading`), ready to be taken out of its box.
+template <int D>
+Specimen<D> formAndUnload(const SpecimenSettings& s, const Release& release, Recorder& rec,
+                          RunControl& control);
 
 // Fixes every wall and takes the walls of every axis but the axial one a box length away.
 template <int D>
@@ -28,13 +63,6 @@ void clearSides(Specimen<D>& sp);
 // the stress its bonds locked in at the formation.
 template <int D>
 void relax(Specimen<D>& sp, std::int64_t max_steps, Recorder& rec, RunControl& control);
-
-// When a tensile test's loading ends: at `strain_max`, or once its load has fallen by `drop`
-// (> 0) below the peak past `min_strain`, a crack having run since the peak (10 bonds
-// broken): near zero load the first steps make and lose small forces without one.
-struct DropRule {
-  double strain_max = 0.0, drop = 0.0, min_strain = 0.0;
-};
 
 // A tensile test's watch over its loading: the peak of the load and what was broken at it,
 // whether the test ends, when it records, and how calm the loading was.
@@ -48,7 +76,11 @@ struct PeakWatch {
   // Takes this step's load and strain: true at a new peak, whose breaks it notes.
   template <int D>
   bool see(const Specimen<D>& sp, double load, double strain);
-  bool ends(double load, double strain, std::size_t breaks, const DropRule& rule) const;
+  // Whether the loading ends: at axial_strain_max, or once the load has fallen by
+  // stop_after_drop (> 0) below the peak past stop_after_drop_min_strain, a crack having run
+  // since the peak (10 bonds broken): near zero load the first steps make and lose small
+  // forces without one.
+  bool ends(double load, double strain, std::size_t breaks, const Loading& rule) const;
   // Whether to record this step: at the interval, at the end, and at new peaks a tenth of
   // it apart, so that the series holds the peak within a few steps where a brittle
   // specimen fails between two regular records.
@@ -77,6 +109,6 @@ void recordLoadingResults(const Specimen<D>& sp, const PeakWatch& w, std::uint64
 
 // Rules across keys both tensile tests share: the unloading below the formation stresses, the
 // strain limit past the drop's, no clumps (a rigid grain can be neither cut nor glued).
-void validateRelease(const SpecimenSettings& specimen, double unload_to, const DropRule& rule);
+void validate(const SpecimenSettings& specimen, const Release& release, const Loading& loading);
 
 }  // namespace rocklab::rigs::tensile
