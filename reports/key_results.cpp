@@ -220,6 +220,20 @@ std::vector<KeyResultRule> directTensionRules() {
   };
 }
 
+std::vector<KeyResultRule> ucsRules() {
+  return {
+      rec("ucs_MPa"),
+      rec("young_modulus_secant_50_MPa"),
+      rec("young_modulus_tangent_50_MPa"),
+      rec("poisson_ratio_secant_50"),
+      rec("poisson_ratio_tangent_50"),
+      rec("crack_damage_stress_MPa"),
+      rec("crack_damage_ratio"),
+      rec("axial_strain_at_peak"),
+      rec("broken_bonds_at_peak"),
+  };
+}
+
 struct RigRules {
   std::string_view rig;
   std::vector<KeyResultRule> rules;
@@ -227,10 +241,15 @@ struct RigRules {
 
 const std::vector<RigRules>& table() {
   static const std::vector<RigRules> t = {
-      {"oedometer", oedometerRules()},     {"biaxial", biaxialRules()},
-      {"envelope", envelopeRules()},       {"hydrostatic", hydrostaticRules()},
-      {"permeameter", permeameterRules()}, {"ultrasonic", ultrasonicRules()},
-      {"brazilian", brazilianRules()},     {"direct_tension", directTensionRules()},
+      {"oedometer", oedometerRules()},
+      {"biaxial", biaxialRules()},
+      {"envelope", envelopeRules()},
+      {"hydrostatic", hydrostaticRules()},
+      {"permeameter", permeameterRules()},
+      {"ultrasonic", ultrasonicRules()},
+      {"brazilian", brazilianRules()},
+      {"direct_tension", directTensionRules()},
+      {"ucs", ucsRules()},
   };
   return t;
 }

@@ -7,6 +7,7 @@
 #include "rigs/permeameter/permeameter.hpp"
 #include "rigs/tensile/brazilian.hpp"
 #include "rigs/tensile/direct.hpp"
+#include "rigs/ucs/ucs.hpp"
 #include "rigs/ultrasonic/ultrasonic.hpp"
 
 namespace rocklab::rigs {
@@ -20,7 +21,7 @@ const std::vector<RigEntry>& rigTable() {
       rigEntry<biaxial::Settings, biaxial::run>(
           "biaxial",
           "biaxial frame (2D) / triaxial cell (3D): confinement held by servo walls, axial "
-          "strain rate through the peak; zero confinement is the UCS test"),
+          "strain rate through the peak; zero confinement: the UCS between walls at zero stress"),
       rigEntry<envelope::Settings, envelope::run>(
           "envelope",
           "failure envelope: one formed sample, a biaxial / triaxial test at each confinement "
@@ -46,6 +47,11 @@ const std::vector<RigEntry>& rigTable() {
           "direct_tension",
           "direct tension: the formed, cemented sample out of its box, its end layers glued to "
           "the platens and pulled apart; tensile strength and modulus in tension"),
+      rigEntry<ucs::Settings, ucs::run>(
+          "ucs",
+          "unconfined compression: the formed, cemented sample (a prism, or a cylinder cut from "
+          "it) between platens with free sides; UCS, Young's modulus and Poisson's ratio at half "
+          "the peak, crack damage stress"),
   };
   return table;
 }

@@ -37,5 +37,6 @@ std::vector<Figure> ultrasonicFigures(const std::vector<const RunData*>& runs, c
 std::vector<Figure> brazilianFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 std::vector<Figure> directTensionFigures(const std::vector<const RunData*>& runs,
                                          const Paper& paper);
+std::vector<Figure> ucsFigures(const std::vector<const RunData*>& runs, const Paper& paper);
 
 }  // namespace rocklab::reports

@@ -4,10 +4,15 @@ namespace rocklab::reports {
 
 const std::vector<FigureEntry>& figureTable() {
   static const std::vector<FigureEntry> table = {
-      {"oedometer", oedometerFigures},     {"hydrostatic", hydrostaticFigures},
-      {"biaxial", biaxialFigures},         {"envelope", envelopeFigures, envelopeEnsembleFigures},
-      {"permeameter", permeameterFigures}, {"ultrasonic", ultrasonicFigures},
-      {"brazilian", brazilianFigures},     {"direct_tension", directTensionFigures},
+      {"oedometer", oedometerFigures},
+      {"hydrostatic", hydrostaticFigures},
+      {"biaxial", biaxialFigures},
+      {"envelope", envelopeFigures, envelopeEnsembleFigures},
+      {"permeameter", permeameterFigures},
+      {"ultrasonic", ultrasonicFigures},
+      {"brazilian", brazilianFigures},
+      {"direct_tension", directTensionFigures},
+      {"ucs", ucsFigures},
   };
   return table;
 }

@@ -20,4 +20,16 @@ inline double slope(const std::vector<double>& x, const std::vector<double>& y) 
   return sxx > 0 ? sxy / sxx : NAN;
 }
 
+// The same over the points [0, end) where take(k) holds; NaN with fewer than 3 of them (two
+// points make a line whatever the noise).
+template <class Take>
+double slopeWhere(const std::vector<double>& x, const std::vector<double>& y, std::size_t end,
+                  Take take) {
+  std::vector<double> xs, ys;
+  for (std::size_t k = 0; k < end && k < x.size(); ++k) {
+    if (take(k)) xs.push_back(x[k]), ys.push_back(y[k]);
+  }
+  return xs.size() >= 3 ? slope(xs, ys) : NAN;
+}
+
 }  // namespace rocklab::rigs

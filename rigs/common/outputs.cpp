@@ -153,10 +153,15 @@ std::string Outputs::help() const {
 
 const Outputs* rigOutputs(std::string_view rig) {
   static const std::pair<std::string_view, const Outputs& (*)()> table[] = {
-      {"oedometer", oedometer::outputs},     {"biaxial", biaxial::outputs},
-      {"envelope", envelope::outputs},       {"hydrostatic", hydrostatic::outputs},
-      {"permeameter", permeameter::outputs}, {"ultrasonic", ultrasonic::outputs},
-      {"brazilian", brazilian::outputs},     {"direct_tension", direct_tension::outputs},
+      {"oedometer", oedometer::outputs},
+      {"biaxial", biaxial::outputs},
+      {"envelope", envelope::outputs},
+      {"hydrostatic", hydrostatic::outputs},
+      {"permeameter", permeameter::outputs},
+      {"ultrasonic", ultrasonic::outputs},
+      {"brazilian", brazilian::outputs},
+      {"direct_tension", direct_tension::outputs},
+      {"ucs", ucs::outputs},
   };
   for (const auto& [name, outputs] : table) {
     if (name == rig) return &outputs();

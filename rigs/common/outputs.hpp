@@ -60,6 +60,10 @@ bool outputNameMatches(std::string_view pattern, std::string_view name);
 // series, the formation and cement results, the break events.
 const Outputs& specimenOutputs();
 
+// What every test on a specimen out of its box records (rigs/common/release.hpp): the
+// specimen's, the unloading, the relaxation and the loading's peak, breaks and calm.
+const Outputs& unconfinedOutputs();
+
 // Each rig's, declared beside it (rigs/<rig>/outputs.cpp).
 namespace oedometer {
 const Outputs& outputs();
@@ -83,6 +87,9 @@ namespace brazilian {
 const Outputs& outputs();
 }
 namespace direct_tension {
+const Outputs& outputs();
+}
+namespace ucs {
 const Outputs& outputs();
 }
 

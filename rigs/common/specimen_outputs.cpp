@@ -56,4 +56,24 @@ const Outputs& specimenOutputs() {
   return o;
 }
 
+const Outputs& unconfinedOutputs() {
+  static const Outputs o =
+      Outputs()
+          .add(specimenOutputs())
+          .prefixes({"unloading."})
+          .results({
+              {"relaxation_steps", "-", "steps the released specimen settled for"},
+              {"relaxation_unbalanced_force_ratio", "-", "its unbalanced force ratio then"},
+              {"broken_bonds_at_peak", "-", "cement bonds broken in the loading by the peak"},
+              {"broken_bonds_tensile_at_peak", "-", "of them in tension"},
+              {"broken_bonds_shear_at_peak", "-", "of them in shear"},
+              {"broken_bonds_total", "-", "cement bonds broken during the loading"},
+              {"loading_steps", "-", "steps of the loading"},
+              {"mean_unbalanced_force_ratio", "-", "mean unbalanced force ratio of the loading"},
+              {"inertial_number_at_peak", "-",
+               "inertial number at the peak, at the test's stress (a disk's nominal stress)"},
+          });
+  return o;
+}
+
 }  // namespace rocklab::rigs

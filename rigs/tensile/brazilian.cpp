@@ -5,13 +5,13 @@
 
 #include "lab/core/errors.hpp"
 #include "rigs/common/measurements.hpp"
+#include "rigs/common/release.hpp"
 #include "rigs/tensile/crack.hpp"
-#include "rigs/tensile/release.hpp"
 
 namespace rocklab::rigs::brazilian {
 
 void Settings::validate() const {
-  tensile::validate(specimen, release, loading);
+  unconfined::validate(specimen, release, loading);
 }
 
 namespace {
@@ -75,7 +75,7 @@ Disk<D> cutDisk(Specimen<D>& sp, const Settings& s, Recorder& rec) {
   }
   const std::size_t before = P.size();
   sim.removeParticles(outside);
-  tensile::clearSides(sp);
+  unconfined::clearSides(sp);
   // The platens touch the disk while it relaxes: a free disk would drift away from them with
   // whatever momentum the cut left it (local damping does not damp a rigid motion).
   seatPlatens(sp);
@@ -93,7 +93,7 @@ Disk<D> cutDisk(Specimen<D>& sp, const Settings& s, Recorder& rec) {
 // What the loading keeps: its start, the peak and how quasi-static it was.
 struct LoadingHistory {
   std::uint64_t start_step = 0;
-  tensile::PeakWatch watch;  // the peak force and the closure at it
+  unconfined::PeakWatch watch;  // the peak force and the closure at it
   double inertial_at_peak = 0.0;
   template <class Archive>
   void visit(Archive& ar) {
@@ -163,12 +163,12 @@ template <int D>
 void recordResults(const Specimen<D>& sp, const Disk<D>& disk, const LoadingHistory& h,
                    Recorder& rec) {
   const auto& sim = *sp.sim;
-  const tensile::PeakWatch& w = h.watch;
+  const unconfined::PeakWatch& w = h.watch;
   const double sigma_t = 2.0 * w.peak / (std::numbers::pi * disk.diameter * disk.thickness);
   rec.result("tensile_strength_MPa", sigma_t / 1e6, "MPa");
   rec.result("peak_force_N", w.peak, "N");
   rec.result("diametral_strain_at_peak", w.peak_strain, "");
-  tensile::recordLoadingResults(sp, w, h.start_step, h.inertial_at_peak, rec);
+  unconfined::recordLoadingResults(sp, w, h.start_step, h.inertial_at_peak, rec);
   // The fracture: the breaks from the peak to the end, where the macroscopic crack runs.
   constexpr int ax = Specimen<D>::kAxial;
   const auto& log = sim.bondBreaks();
@@ -197,10 +197,10 @@ void recordResults(const Specimen<D>& sp, const Disk<D>& disk, const LoadingHist
 
 template <int D>
 void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
-  Specimen<D> sp = tensile::formAndUnload<D>(s.specimen, s.release, rec, control);
+  Specimen<D> sp = unconfined::formAndUnload<D>(s.specimen, s.release, rec, control);
   const Disk<D> disk = cutDisk(sp, s, rec);
   snapshot(sp, rec, "cut", "disk");
-  tensile::relax(sp, s.release.relax_steps_max, rec, control);
+  unconfined::relax(sp, s.release.relax_steps_max, rec, control);
   const LoadingHistory h = load(sp, s, disk, rec, control);
   recordResults(sp, disk, h, rec);
   recordTimings<D>(rec, {sp.sim.get()});

@@ -8,15 +8,15 @@
 
 #include "rigs/common/loading_keys.hpp"
 #include "rigs/common/outputs.hpp"
+#include "rigs/common/release.hpp"
 #include "rigs/common/specimen.hpp"
-#include "rigs/tensile/release.hpp"
 
 namespace rocklab::rigs::brazilian {
 
 struct Settings {
   SpecimenSettings specimen;
-  tensile::Release release;
-  tensile::Loading loading{0.5, 0.05, 0.5, 0.001};
+  unconfined::Release release;
+  unconfined::Loading loading{0.5, 0.05, 0.5, 0.001};
   double diameter_ratio = 0.9;  // the disk's diameter over the box's smaller side
 
   template <class F>
@@ -25,8 +25,7 @@ struct Settings {
     f.section("loading.", loading);
     f.section("release.", release);
     auto cut = f.at("cut.");
-    cut(diameter_ratio, {"diameter_ratio", units::none, Range::leftOpen(0, 1),
-                         "the disk's diameter over the box's smaller side in the loading plane"});
+    cut(diameter_ratio, unconfined::kCutDiameterRatio);
   }
   // The disk must hold some particles across (a diameter of at least 10 mean diameters is
   // checked when it is cut); clumps cannot be cut through.

@@ -4,13 +4,14 @@
 #include <cmath>
 
 #include "lab/core/errors.hpp"
+#include "rigs/common/analysis.hpp"
 #include "rigs/common/measurements.hpp"
 #include "rigs/tensile/crack.hpp"
 
 namespace rocklab::rigs::direct_tension {
 
 void Settings::validate() const {
-  tensile::validate(specimen, release, loading);
+  unconfined::validate(specimen, release, loading);
 }
 
 namespace {
@@ -59,7 +60,7 @@ Grips glue(Specimen<D>& sp, const Settings& s, Recorder& rec) {
   auto& frame = *sp.frame;
   Grips g;
   g.area = frame.faceArea(ax);
-  tensile::clearSides(sp);
+  unconfined::clearSides(sp);
   const double away = frame.length(ax);
   frame.place(ax, sim.wall(2 * ax).point[ax] - away, sim.wall(2 * ax + 1).point[ax] + away);
   const auto& P = sim.particles();
@@ -93,7 +94,7 @@ Grips glue(Specimen<D>& sp, const Settings& s, Recorder& rec) {
 // how quasi-static it was.
 struct PullHistory {
   std::uint64_t start_step = 0;
-  tensile::PeakWatch watch;  // the peak stress and the strain at it
+  unconfined::PeakWatch watch;  // the peak stress and the strain at it
   double inertial_at_peak = 0.0;
   std::vector<double> strain, stress;
   template <class Archive>
@@ -161,26 +162,22 @@ PullHistory pull(Specimen<D>& sp, const Settings& s, const Grips& g, Recorder& r
 // from 10% to 50% of the peak before it (the elastic part, past the first seating).
 double tensileModulus(const PullHistory& h) {
   const double peak = h.watch.peak;
-  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t k = 0; k < h.strain.size() && h.strain[k] <= h.watch.peak_strain; ++k) {
-    if (h.stress[k] < 0.1 * peak || h.stress[k] > 0.5 * peak) continue;
-    n += 1, sx += h.strain[k], sy += h.stress[k];
-    sxx += h.strain[k] * h.strain[k], sxy += h.strain[k] * h.stress[k];
-  }
-  const double den = n * sxx - sx * sx;
-  return n >= 3 && den > 0.0 ? (n * sxy - sx * sy) / den : NAN;
+  return slopeWhere(h.strain, h.stress, h.strain.size(), [&](std::size_t k) {
+    return h.strain[k] <= h.watch.peak_strain && h.stress[k] >= 0.1 * peak &&
+           h.stress[k] <= 0.5 * peak;
+  });
 }
 
 template <int D>
 void recordResults(const Specimen<D>& sp, const Grips& g, const PullHistory& h, Recorder& rec) {
   constexpr int ax = Specimen<D>::kAxial;
   const auto& sim = *sp.sim;
-  const tensile::PeakWatch& w = h.watch;
+  const unconfined::PeakWatch& w = h.watch;
   rec.result("tensile_strength_MPa", w.peak / 1e6, "MPa");
   rec.result("peak_force_N", w.peak * g.area, "N");
   rec.result("axial_strain_at_peak", w.peak_strain, "");
   rec.result("tensile_modulus_MPa", tensileModulus(h) / 1e6, "MPa");
-  tensile::recordLoadingResults(sp, w, h.start_step, h.inertial_at_peak, rec);
+  unconfined::recordLoadingResults(sp, w, h.start_step, h.inertial_at_peak, rec);
   // The fracture: the breaks from the peak on. Its axis lies across the load; where it lies
   // along the gauge says whether the specimen broke in it or at a glued layer.
   const auto& log = sim.bondBreaks();
@@ -211,9 +208,9 @@ void recordResults(const Specimen<D>& sp, const Grips& g, const PullHistory& h, 
 
 template <int D>
 void runDimension(const Settings& s, Recorder& rec, RunControl& control) {
-  Specimen<D> sp = tensile::formAndUnload<D>(s.specimen, s.release, rec, control);
+  Specimen<D> sp = unconfined::formAndUnload<D>(s.specimen, s.release, rec, control);
   const Grips g = glue(sp, s, rec);
-  tensile::relax(sp, s.release.relax_steps_max, rec, control);
+  unconfined::relax(sp, s.release.relax_steps_max, rec, control);
   const PullHistory h = pull(sp, s, g, rec, control);
   recordResults(sp, g, h, rec);
   recordTimings<D>(rec, {sp.sim.get()});

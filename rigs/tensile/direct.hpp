@@ -6,15 +6,15 @@
 
 #include "rigs/common/loading_keys.hpp"
 #include "rigs/common/outputs.hpp"
+#include "rigs/common/release.hpp"
 #include "rigs/common/specimen.hpp"
-#include "rigs/tensile/release.hpp"
 
 namespace rocklab::rigs::direct_tension {
 
 struct Settings {
   SpecimenSettings specimen;
-  tensile::Release release;
-  tensile::Loading loading{0.5, 0.02, 0.5, 0.0};
+  unconfined::Release release;
+  unconfined::Loading loading{0.5, 0.02, 0.5, 0.0};
   double layer_diameters = 2.0;  // glued layers' thickness, in mean particle diameters
 
   template <class F>

@@ -6,24 +6,12 @@ namespace rocklab::rigs::tensile {
 
 namespace {
 
-// What both tests record: the specimen's, the release and what every loading records
-// (rigs/tensile/release.hpp).
+// What both tests record: what every test out of its box records, and the fracture.
 const Outputs& outputs() {
   static const Outputs o =
       Outputs()
-          .add(specimenOutputs())
-          .prefixes({"unloading."})
+          .add(unconfinedOutputs())
           .results({
-              {"relaxation_steps", "-", "steps the released specimen settled for"},
-              {"relaxation_unbalanced_force_ratio", "-", "its unbalanced force ratio then"},
-              {"broken_bonds_at_peak", "-", "cement bonds broken in the loading by the peak"},
-              {"broken_bonds_tensile_at_peak", "-", "of them in tension"},
-              {"broken_bonds_shear_at_peak", "-", "of them in shear"},
-              {"broken_bonds_total", "-", "cement bonds broken during the loading"},
-              {"loading_steps", "-", "steps of the loading"},
-              {"mean_unbalanced_force_ratio", "-", "mean unbalanced force ratio of the loading"},
-              {"inertial_number_at_peak", "-",
-               "inertial number at the peak, at the test's stress (a disk's nominal stress)"},
               {"fracture_breaks", "-", "bonds broken from the peak to the end: the fracture"},
           });
   return o;

@@ -8,7 +8,7 @@
 #include "rigs/common/loading_keys.hpp"
 #include "rigs/common/specimen.hpp"
 
-namespace rocklab::rigs::tensile {
+namespace rocklab::rigs::unconfined {
 
 // The release (`release.*`): the formation stress relieved, the specimen settled once out
 // of its box.
@@ -47,6 +47,13 @@ struct Loading {
     f(stop_after_drop_min_strain, loading_keys::kStopAfterDropMinStrain);
   }
 };
+
+// `cut.diameter_ratio`, the one key of a cut both the Brazilian disk and the UCS cylinder
+// take: the cut's diameter over the box's smaller side across the cylinder's axis.
+inline constexpr Field kCutDiameterRatio{
+    "diameter_ratio", units::none, Range::leftOpen(0, 1),
+    "diameter of the disk (Brazilian) or cylinder (UCS) cut from the sample, over the box's "
+    "smaller side across its axis"};
 
 // Builds, forms and cements the sample and relieves its formation stress (stage
 // `unloading`), ready to be taken out of its box.
@@ -111,4 +118,4 @@ void recordLoadingResults(const Specimen<D>& sp, const PeakWatch& w, std::uint64
 // strain limit past the drop's, no clumps (a rigid grain can be neither cut nor glued).
 void validate(const SpecimenSettings& specimen, const Release& release, const Loading& loading);
 
-}  // namespace rocklab::rigs::tensile
+}  // namespace rocklab::rigs::unconfined

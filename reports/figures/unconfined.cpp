@@ -1,4 +1,5 @@
-// The tensile tests' figures: the load against the deformation with the bond breaks as they
+// The figures of the tests on a specimen out of its box (the tensile tests and the
+// unconfined compression): the load against the deformation with the bond breaks as they
 // accumulate, and the fracture (where the bonds broke in the loading plane, by mode), every
 // run overlaid.
 
@@ -55,6 +56,36 @@ Figure fracture(const std::vector<const RunData*>& runs, const std::string& id,
   return f;
 }
 
+// The axial stress against the three strains a compression test measures (the platens'
+// axial, the gauge's lateral and volumetric), and the breaks by mode against the axial strain.
+Figure compression(const std::vector<const RunData*>& runs) {
+  Figure f{"ucs-stress-strain",
+           "Unconfined compression: stress against strains, and breaks",
+           "Axial stress against the platens' axial strain and the gauge section's lateral and "
+           "volumetric strains, compression positive (top; the peak is the UCS, the volumetric "
+           "strain's turn the crack damage stress), and the cement bonds broken since loading "
+           "began, by mode, against the axial strain (bottom).",
+           {}};
+  Panel curves{"strain (-)", "axial stress (MPa)", {}};
+  Panel broken{"axial strain (-)", "broken bonds (cumulative)", {}};
+  for (const RunData* r : runs) {
+    for (const auto& [strain, what] : {std::pair{"axial_strain", "axial"},
+                                       {"lateral_strain", "lateral"},
+                                       {"volumetric_strain", "volumetric"}}) {
+      Series s{r->label() + " " + what, {}, {}, false};
+      pair(*r, strain, "axial_stress_MPa", s.x, s.y);
+      if (!s.x.empty()) curves.series.push_back(s);
+    }
+    for (const char* mode : {"tensile", "shear"}) {
+      Series b{r->label() + " " + mode, {}, {}, false};
+      pair(*r, "axial_strain", std::string("broken_bonds_") + mode, b.x, b.y);
+      if (!b.x.empty()) broken.series.push_back(b);
+    }
+  }
+  if (!curves.series.empty()) f.panels = {curves, broken};
+  return f;
+}
+
 std::vector<Figure> nonEmpty(std::vector<Figure> figures) {
   std::erase_if(figures, [](const Figure& f) { return f.panels.empty(); });
   return figures;
@@ -83,6 +114,11 @@ std::vector<Figure> directTensionFigures(const std::vector<const RunData*>& runs
                      "between the glued layers.",
                      "axial_strain", "axial strain (-)", "tensile stress (MPa)"),
        fracture(runs, "direct-tension-fracture", "Direct tension: the fracture")});
+}
+
+std::vector<Figure> ucsFigures(const std::vector<const RunData*>& runs, const Paper&) {
+  return nonEmpty(
+      {compression(runs), fracture(runs, "ucs-fracture", "Unconfined compression: the fracture")});
 }
 
 }  // namespace rocklab::reports

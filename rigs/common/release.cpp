@@ -1,10 +1,10 @@
-#include "rigs/tensile/release.hpp"
+#include "rigs/common/release.hpp"
 
 #include "lab/core/errors.hpp"
 #include "rigs/common/formation.hpp"
 #include "rigs/common/measurements.hpp"
 
-namespace rocklab::rigs::tensile {
+namespace rocklab::rigs::unconfined {
 
 template <int D>
 Specimen<D> formAndUnload(const SpecimenSettings& s, const Release& release, Recorder& rec,
@@ -157,4 +157,4 @@ template void clearSides<3>(Specimen<3>&);
 template void relax<2>(Specimen<2>&, std::int64_t, Recorder&, RunControl&);
 template void relax<3>(Specimen<3>&, std::int64_t, Recorder&, RunControl&);
 
-}  // namespace rocklab::rigs::tensile
+}  // namespace rocklab::rigs::unconfined
