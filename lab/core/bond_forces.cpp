@@ -28,6 +28,10 @@ void BondKind::validate() const {
                            "applies to parallel bonds only: a flat joint's elements break on "
                            "their centroid stresses (leave it at 1 with model = flat_joint)");
   }
+  if (model != BondModel::FlatJoint && flat_joint_slit_fraction != 0.0) {
+    throw InvalidParameter("", "flat_joint_slit_fraction",
+                           "applies to flat joints only: set model = flat_joint, or leave it at 0");
+  }
   if (negative == NegativeStrength::Resample && (tensile_mean <= 0.0 || shear_mean <= 0.0)) {
     throw InvalidParameter("", "negative_strength",
                            "resample needs positive mean strengths (it draws until positive)");

@@ -62,6 +62,12 @@ struct BondKind {
   std::int64_t flat_joint_radial = 2;           // 2D: elements along the face; 3D: rings
   std::int64_t flat_joint_circumferential = 3;  // 3D: sectors per ring (PFC's usual 1 x 3)
   double flat_joint_friction = 0.5;             // -, friction coefficient of broken elements
+  // PFC 5's slit elements (fj_slit; Potyondy 2012): the fraction of a flat joint's elements
+  // installed unbonded, each drawn alone. They carry compression and friction but no tension
+  // from the start: a cemented rock's grain boundaries are not cemented all over, and this is
+  // what lets a flat-jointed material's tensile strength fall while its compressive strength
+  // holds (UCS / sigma_t of 10 and more).
+  double flat_joint_slit_fraction = 0.0;
 
   // The intragranular bonds of breakable grains: stiffer and stronger than the cement, and
   // never missing (a grain is not born cracked: draws <= 0 are drawn again).
@@ -112,6 +118,9 @@ struct BondKind {
        "flat joint, 3D: elements around each ring"});
     f(flat_joint_friction, {"flat_joint_friction", units::none, Range::closed(0, 10),
                             "flat joint: friction coefficient of the broken elements"});
+    f(flat_joint_slit_fraction,
+      {"flat_joint_slit_fraction", units::none, Range::rightOpen(0, 1),
+       "flat joint: fraction of the elements installed unbonded (slit), each drawn alone"});
   }
   // A mean at or below zero with Resample would loop for ever drawing a positive strength.
   void validate() const;
@@ -125,6 +134,7 @@ struct BondKind {
     ar("negative", negative), ar("model", model), ar("flat_joint_radial", flat_joint_radial);
     ar("flat_joint_circumferential", flat_joint_circumferential);
     ar("flat_joint_friction", flat_joint_friction);
+    ar("flat_joint_slit_fraction", flat_joint_slit_fraction);
   }
   template <int D>
   FaceLayout faceLayout() const {

@@ -314,8 +314,8 @@ class Simulation {
   // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle and moment_factor,
   // 5 config.skin_ratio, 6 the applied forces, 7 density scaling (the particles' physical
   // masses, config.timestep.density_scaling, ledger.mass_scaling), 8 flat joints (the bond
-  // kinds' model and faces, the bonds' face states).
-  static constexpr std::uint32_t kCheckpointVersion = 8;
+  // kinds' model and faces, the bonds' face states), 9 the flat joints' slit fraction.
+  static constexpr std::uint32_t kCheckpointVersion = 9;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };

@@ -133,6 +133,13 @@ CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
       bonds_.face.push_back(kind.model == BondModel::FlatJoint
                                 ? installFace<D>(layout, (P.pos[j] - P.pos[i]).normalized())
                                 : FaceState<D>{});
+      // Slit elements: drawn only when there are any, so that a face without them leaves the
+      // stream of strengths as it was.
+      if (kind.flat_joint_slit_fraction > 0.0) {
+        for (FaceElement<D>& e : bonds_.face.back().elements) {
+          if (rng_.uniform() < kind.flat_joint_slit_fraction) e.bonded = 0;
+        }
+      }
       ++report.installed;
     }
   }

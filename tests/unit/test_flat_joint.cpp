@@ -304,12 +304,71 @@ TEST(FlatJointPass, LanesAndThreadsGiveTheSerialBitsWithJointsAmongTheBonds) {
   EXPECT_EQ(fast.hash, serial.hash);
 }
 
+// Slit elements (PFC's fj_slit): each element of every face is installed unbonded with the
+// slit fraction's probability, alone: over a lattice's faces their share is the fraction
+// within the binomial's 4 standard deviations, and some faces hold both kinds.
+TEST(FlatJointSlits, EachElementIsSlitWithTheFractionsProbability) {
+  Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), testing::undamped());
+  for (int x = 0; x < 8; ++x) {
+    for (int y = 0; y < 8; ++y) {
+      for (int z = 0; z < 8; ++z) {
+        testing::addParticle<3>(sim, V3(2 * kR * V3(x, y, z)), kR, V3::Zero());
+      }
+    }
+  }
+  BondKind k = joint(8e6, 8e6, 2, 3);
+  k.flat_joint_slit_fraction = 0.4;
+  EXPECT_EQ(sim.cement(sim.addBondKind(k), 0.01).installed, 3u * 8 * 8 * 7);
+  double elements = 0, slit = 0;
+  std::size_t mixed = 0;
+  for (const FaceState<3>& f : sim.bonds().face) {
+    std::size_t here = 0;
+    for (const FaceElement<3>& e : f.elements) here += e.bonded ? 0 : 1;
+    elements += static_cast<double>(f.elements.size());
+    slit += static_cast<double>(here);
+    mixed += here > 0 && here < f.elements.size() ? 1 : 0;
+  }
+  EXPECT_NEAR(slit / elements, 0.4, 4.0 * std::sqrt(0.4 * 0.6 / elements));
+  EXPECT_GT(mixed, sim.bonds().size() / 2);
+}
+
+// A face with slits pulled apart: only its bonded elements hold tension, so it breaks at the
+// tensile strength times their area (every element at the same approach in a pure pull), and
+// its slit elements never break (no break event of theirs).
+TEST(FlatJointSlits, APulledFaceHoldsTensionOnItsBondedElementsOnly) {
+  const double strength = 8e6, v = 0.01;
+  BondKind k = joint(strength, 1e11, 2, 3);
+  k.flat_joint_slit_fraction = 0.5;
+  BondedPair<3> p(k);
+  const FaceLayout layout = k.faceLayout<3>();
+  double bonded_area = 0;
+  std::size_t bonded = 0;
+  for (std::size_t e = 0; e < layout.elements.size(); ++e) {
+    if (p.sim.bonds().face[0].elements[e].bonded) {
+      bonded_area += layout.elements[e].area * kR * kR, ++bonded;  // the unit face's, at R
+    }
+  }
+  ASSERT_GT(bonded, 0u) << "the seed slit every element: pick a face with some bonded";
+  ASSERT_LT(bonded, layout.elements.size()) << "the seed slit none";
+  double peak = 0;
+  while (p.sim.bondBreaks().empty()) {
+    p.drive(V3::Zero(), v * p.n, V3::Zero(), V3::Zero(), 1);
+    peak = std::max(peak, p.force().dot(-p.n));
+  }
+  const double per_step = p.kn() * v * kDt;
+  EXPECT_NEAR(peak, strength * bonded_area, per_step * bonded_area);
+  EXPECT_EQ(p.sim.bondBreaks().size(), bonded);
+}
+
 TEST(FlatJoint, KindsAreValidated) {
   Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), testing::undamped());
   BondKind k = joint(8e6, 8e6, 2, 3);
   k.moment_factor = 0.5;  // applies to parallel bonds only
   EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
   k = joint(8e6, 8e6, 0, 3);
+  EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
+  k = cement(8e6, 8e6);
+  k.flat_joint_slit_fraction = 0.2;  // a parallel bond has no elements to slit
   EXPECT_THROW(sim.addBondKind(k), InvalidParameter);
 }
 
