@@ -13,6 +13,7 @@ ROCKLAB := $(BUILD)/rocklab
 DEMO_DIR := build/demo
 
 .PHONY: deps build demo test test-full test-slurm test-sanitize bench bench-packings catalogue references \
+  bond-model-reach \
   gallery format clean
 
 # Installs only the Debian packages that are missing (a no-op when all are present);
@@ -100,6 +101,17 @@ catalogue: build
 references: build
 	$(ROCKLAB) regress update protocols/*-quick.toml --out tests/reference \
 	  --lab build/references.sqlite --seeds 3
+
+# What each bond model reaches (issue 28): the bond-model-reach campaigns (UCS and direct
+# tension of one 3D bonded sphere pack per bond model and cement, 3 seeds each) and their
+# report, UCS / sigma_t seed by seed (build/bond-model-reach/index.html). About two hours on 2
+# cores: a flat-jointed run takes 5 to 10 times a parallel-bonded one.
+REACH_LAB := build/bond-model-reach.sqlite
+bond-model-reach: build
+	for c in protocols/campaigns/bond-model-reach-*.toml; do \
+	  $(ROCKLAB) campaign run $$c --lab $(REACH_LAB) || exit 1; \
+	done
+	tests/bond_model_reach.py --lab $(REACH_LAB) --out build/bond-model-reach
 
 # The accuracy gallery (reports/gallery, shown in the README): one cost-accuracy study per rig,
 # each a ladder of one numerical setting, finest first. `make -j2 gallery` runs two at once.

@@ -215,8 +215,9 @@ std::vector<KeyResultRule> brazilianRules() {
 
 std::vector<KeyResultRule> directTensionRules() {
   return {
-      rec("tensile_strength_MPa"), rec("tensile_modulus_MPa"),   rec("axial_strain_at_peak"),
-      rec("broken_bonds_at_peak"), rec("fracture_height_ratio"),
+      rec("tensile_strength_MPa"),  rec("tensile_modulus_MPa"),
+      rec("axial_strain_at_peak"),  rec("broken_bonds_at_peak"),
+      rec("fracture_height_ratio"), rec("fracture_angle_to_loading_deg"),
   };
 }
 

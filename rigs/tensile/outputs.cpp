@@ -98,6 +98,8 @@ const Outputs& outputs() {
               {"axial_strain_at_peak", "-", "gauge extension at the peak"},
               {"broken_bonds_at_peak", "-", "cement bonds broken in the loading by the peak"},
               {"fracture_height_ratio", "-", "where the fracture lies, 0 bottom to 1 top"},
+              {"fracture_angle_to_loading_deg", "deg",
+               "the fracture's axis against the load (90: across it)"},
           });
   return o;
 }
