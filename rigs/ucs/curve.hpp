@@ -100,7 +100,7 @@ inline HalfPeakModuli halfPeakModuli(const CompressionCurve& c, std::size_t peak
 // the peak, where dilatancy overtakes the elastic compaction. A sample that compacts up to
 // its peak has it at the peak.
 struct CrackDamage {
-  double stress = NAN, volumetric = NAN, axial = NAN;
+  double stress = NAN, volumetric = NAN;
   std::size_t index = 0;
 };
 
@@ -114,7 +114,6 @@ inline CrackDamage crackDamage(const CompressionCurve& c, std::size_t peak) {
   d.index = best;
   d.stress = c.stress[best];
   d.volumetric = c.volumetric[best];
-  d.axial = c.axial[best];
   return d;
 }
 

@@ -25,10 +25,6 @@ namespace {
 // diameter) and its height.
 struct Section {
   double area = 0.0, width = 0.0, height = 0.0;  // m^2 (2D: width x thickness), m, m
-  template <class Archive>
-  void visit(Archive& ar) {
-    ar("area", area), ar("width", width), ar("height", height);
-  }
 };
 
 // The distance of x from the specimen's axis (through `centre`, along the axial axis).
