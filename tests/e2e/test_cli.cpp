@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <string>
 
@@ -270,6 +271,35 @@ TEST(Cli, StudyAndRegressRefuseBadInputBeforeRunning) {
   EXPECT_NE(r.out.find("no such reference file"), std::string::npos) << r.out;
   r = run("regress update " + protocol + " --seeds 1");
   EXPECT_NE(r.status, 0);
+}
+
+// The protocols that ship are valid, each named as its file. Every quick twin has the
+// regression reference its e2e test holds it to, and runs the rig of its full-size twin.
+TEST(Cli, ShippedProtocolsCheck) {
+  namespace fs = std::filesystem;
+  const fs::path source = ROCKLAB_SOURCE_DIR;
+  const auto field = [](const fs::path& file, const std::string& key) {
+    std::ifstream in(file);
+    const std::string text((std::istreambuf_iterator<char>(in)), {});
+    std::smatch m;
+    return std::regex_search(text, m, std::regex("\\n" + key + " = \"([^\"]+)\"")) ? m[1].str()
+                                                                                   : std::string();
+  };
+  int checked = 0;
+  for (const auto& f : fs::directory_iterator(source / "protocols")) {
+    if (f.path().extension() != ".toml") continue;
+    const auto r = run("check " + f.path().string());
+    EXPECT_EQ(r.status, 0) << r.out;
+    const std::string stem = f.path().stem().string();
+    EXPECT_EQ(field(f.path(), "name"), stem) << f.path();
+    if (stem.ends_with("-quick")) {
+      EXPECT_TRUE(fs::exists(source / "tests/reference" / (stem + ".toml"))) << stem;
+      const fs::path full = source / "protocols" / (stem.substr(0, stem.size() - 6) + ".toml");
+      if (fs::exists(full)) EXPECT_EQ(field(full, "rig"), field(f.path(), "rig")) << full;
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 30);
 }
 
 }  // namespace
