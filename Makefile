@@ -102,10 +102,11 @@ references: build
 	$(ROCKLAB) regress update protocols/*-quick.toml --out tests/reference \
 	  --lab build/references.sqlite --seeds 3
 
-# What each bond model reaches (issue 28): the bond-model-reach campaigns (UCS and direct
-# tension of one 3D bonded sphere pack per bond model and cement, 3 seeds each) and their
-# report, UCS / sigma_t seed by seed (build/bond-model-reach/index.html). About two hours on 2
-# cores: a flat-jointed run takes 5 to 10 times a parallel-bonded one.
+# What each bond model reaches (issue 28): the bond-model-reach campaigns (the UCS test, direct
+# tension and the triaxial cell on one 3D bonded sphere pack per bond model and cement, 3 seeds
+# each) and their report: UCS / sigma_t seed by seed, the friction angle
+# (build/bond-model-reach/index.html). About three hours on 2 cores: a flat-jointed run takes
+# 5 to 20 times a parallel-bonded one.
 REACH_LAB := build/bond-model-reach.sqlite
 bond-model-reach: build
 	for c in protocols/campaigns/bond-model-reach-*.toml; do \
