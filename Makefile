@@ -105,7 +105,7 @@ references: build
 # What each bond model reaches (issue 28): the bond-model-reach campaigns (the UCS test, direct
 # tension and the triaxial cell on one 3D bonded sphere pack per bond model and cement, 3 seeds
 # each) and their report: UCS / sigma_t seed by seed, the friction angle
-# (build/bond-model-reach/index.html). About three hours on 2 cores: a flat-jointed run takes
+# (build/bond-model-reach/index.html). About four hours on 2 cores: a flat-jointed run takes
 # 5 to 20 times a parallel-bonded one.
 REACH_LAB := build/bond-model-reach.sqlite
 bond-model-reach: build
