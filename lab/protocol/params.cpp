@@ -187,7 +187,9 @@ const std::vector<std::string>& Settings::texts(const std::string& key) const {
 std::string Settings::where(const std::string& key) const {
   if (auto o = overrides_.find(key); o != overrides_.end()) return o->second.label();
   auto it = given_.find(key);
-  return file_ + (it == given_.end() ? "" : ":" + std::to_string(it->second));
+  const auto in = given_in_.find(key);
+  return (in == given_in_.end() ? file_ : in->second) +
+         (it == given_.end() ? "" : ":" + std::to_string(it->second));
 }
 
 std::vector<notebook::ParamRow> Settings::table() const {
@@ -448,6 +450,44 @@ void Settings::apply(const std::vector<Override>& overrides) {
   overrides_ = std::move(applied);
 }
 
+namespace {
+
+constexpr const char* kInclude = "include";
+
+// The files a protocol's top-level `include` names (a text or a list of texts), resolved
+// against the protocol's folder, each with the place that names it.
+std::vector<std::pair<std::string, Place>> includedFiles(const std::string& file,
+                                                         const TomlValue& root,
+                                                         Problems& problems) {
+  std::vector<std::pair<std::string, Place>> files;
+  if (!root.contains(kInclude)) return files;
+  const TomlValue& v = root.at(kInclude);
+  const int line = static_cast<int>(v.location().line());
+  const Place place{line, file + ":" + std::to_string(line)};
+  std::vector<std::string> names;
+  if (v.is_string()) {
+    names.push_back(v.as_string().str);
+  } else if (v.is_array()) {
+    for (const auto& e : v.as_array()) {
+      if (e.is_string()) names.push_back(e.as_string().str);
+    }
+  }
+  if (names.empty() || (v.is_array() && names.size() != v.as_array().size())) {
+    problems.at(place, std::string(kInclude) +
+                           " expects a file or a list of files, e.g. include = "
+                           "\"materials/sandstone.toml\" (relative to the protocol's folder)");
+    return files;
+  }
+  const std::filesystem::path folder = std::filesystem::path(file).parent_path();
+  for (const std::string& n : names) {
+    const std::filesystem::path p(n);
+    files.emplace_back((p.is_absolute() ? p : folder / p).lexically_normal().string(), place);
+  }
+  return files;
+}
+
+}  // namespace
+
 Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema,
                        const std::vector<Override>& overrides) {
   const TomlValue root = parseToml(file, text);
@@ -456,22 +496,59 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
   s.file_ = file;
   s.source_ = text;
   Problems problems(file);
-  auto walk = [&](auto&& self, const TomlValue& table, const std::string& prefix) -> void {
+  // The keys of `table` given in `from` (the protocol or a file it includes); problems are
+  // ordered by `order` + line.
+  auto walk = [&](auto&& self, const TomlValue& table, const std::string& prefix,
+                  const std::string& from, int order) -> void {
     for (const auto& [k, v] : table.as_table()) {
+      if (prefix.empty() && k == kInclude) continue;
       const std::string key = prefix.empty() ? k : prefix + "." + k;
       const int line = static_cast<int>(v.location().line());
       if (v.is_table()) {
-        self(self, v, key);
+        self(self, v, key, from, order);
         continue;
       }
-      const Place place{line, file + ":" + std::to_string(line)};
+      const Place place{order + line, from + ":" + std::to_string(line)};
       const ParamDecl* d = declarationOf(schema, key, place, problems);
       if (!d) continue;
+      if (s.given_.count(key)) {
+        problems.at(place, key + " is given again: " + s.where(key) +
+                               " gives it too (give a key in one file; --set overrides it "
+                               "wherever it is given)");
+        continue;
+      }
       s.given_[key] = line;
+      if (from != file) s.given_in_[key] = from;
       if (auto value = valueOf(*d, v, place, problems)) s.values_[key] = std::move(*value);
     }
   };
-  walk(walk, root, "");
+  walk(walk, root, "", file, 0);
+  int order = 1 << 27;  // an included file's problems after the protocol's
+  for (const auto& [path, place] : includedFiles(file, root, problems)) {
+    order += 1 << 20;
+    std::string included;
+    try {
+      included = readFile(path);
+    } catch (const ProtocolError&) {
+      problems.at(place, std::string(kInclude) + ": cannot read " + path);
+      continue;
+    }
+    TomlValue inc;
+    try {
+      inc = parseToml(path, included);
+    } catch (const ProtocolError& e) {
+      for (const auto& p : e.problems()) problems.at(place, std::string(kInclude) + ": " + p);
+      continue;
+    }
+    if (inc.contains(kInclude) || inc.contains("protocol")) {
+      problems.at(place, std::string(kInclude) + ": " + path +
+                             " may hold a material's keys only: no include of its own and no "
+                             "protocol.* key (the protocol names the run)");
+      continue;
+    }
+    s.includes_.push_back(path);
+    walk(walk, inc, "", path, order);
+  }
   applyOverrides(schema, overrides, s.values_, s.given_, s.overrides_, problems);
   for (const ParamDecl& d : schema.all()) {
     if (s.given_.count(d.key)) continue;
@@ -578,20 +655,22 @@ std::string editedText(const std::string& source,
 }  // namespace
 
 std::string Settings::effectiveText() const {
-  if (overrides_.empty()) return source_;
+  if (overrides_.empty() && includes_.empty()) return source_;
   std::map<std::string, Value> values = values_;  // as given: the run's choices left out
   for (const auto& [key, v] : unchosen_) values[key] = v;
-  std::string head = "# The protocol as run: " + file_ + " with ";
+  std::string with;
+  for (const std::string& inc : includes_) with += (with.empty() ? "" : ", ") + ("include " + inc);
   std::vector<std::tuple<std::string, int, std::string>> edits;
   for (const auto& [key, o] : overrides_) {
-    head += (edits.empty() ? "" : ", ") + o.label();
-    const int line = given_.count(key) ? given_.at(key) : 0;
+    with += (with.empty() ? "" : ", ") + o.label();
+    const int line = given_.count(key) && !given_in_.count(key) ? given_.at(key) : 0;
     edits.emplace_back(key, line, tomlLiteral(values.at(key)) + "  # " + o.label());
   }
-  head += "\n";
+  const std::string head = "# The protocol as run: " + file_ + " with " + with + "\n";
   // The edited file reads back to these settings, or (an override inside a multi-line value
-  // or a table the file defines by dotted keys) every key is written out, table by table.
-  std::string text = editedText(source_, edits);
+  // or a table the file defines by dotted keys; an included file, whose keys must be in the
+  // text for it to stand alone) every key is written out, table by table.
+  std::string text = includes_.empty() ? editedText(source_, edits) : std::string();
   auto readsBack = [&](const std::string& t) {
     try {
       const Settings back = parseProtocol(file_, t, *schema_);
@@ -608,10 +687,13 @@ std::string Settings::effectiveText() const {
     const auto [table, leaf] = splitKey(d.key);
     if (!tables.count(table)) order.push_back(table);
     const auto o = overrides_.find(d.key);
-    tables[table].push_back(leaf + " = " + tomlLiteral(values.at(d.key)) +
-                            (o == overrides_.end() ? "" : "  # " + o->second.label()));
+    const auto in = given_in_.find(d.key);
+    const std::string note = o != overrides_.end()   ? "  # " + o->second.label()
+                             : in != given_in_.end() ? "  # " + in->second
+                                                     : "";
+    tables[table].push_back(leaf + " = " + tomlLiteral(values.at(d.key)) + note);
   }
-  text = head + "# (every key the file and the overrides give, written out)\n";
+  text = head + "# (every key the file, its includes and the overrides give, written out)\n";
   for (const std::string& t : order) {
     text += "\n[" + t + "]\n";
     for (const auto& l : tables[t]) text += l + "\n";

@@ -97,8 +97,8 @@ class Settings {
   const std::vector<double>& list(const std::string& key) const;
   const std::vector<std::string>& texts(const std::string& key) const;
   bool given(const std::string& key) const { return given_.count(key) > 0; }
-  // Where a key was set, for errors found across keys: "file:line", or the override
-  // ("--set KEY=VALUE") that gave it.
+  // Where a key was set, for errors found across keys: "file:line" (of the protocol or of
+  // the file it includes that gives the key), or the override ("--set KEY=VALUE").
   std::string where(const std::string& key) const;
   // Every parameter with its value (given or default) and unit.
   std::vector<notebook::ParamRow> table() const;
@@ -116,9 +116,12 @@ class Settings {
   const ParamDecl& decl(const std::string& key) const;  // throws std::logic_error if undeclared
   // The protocol file's text as read.
   const std::string& source() const { return source_; }
-  // The protocol as run: the file's text when nothing was overridden, else the text with
-  // each override written in and marked ("# --set ..."), so that parsing it alone gives
-  // these settings (the notebook keeps it; `rocklab rerun` runs it again).
+  // The files its `include` names (a material's keys), as paths from the working folder.
+  const std::vector<std::string>& includes() const { return includes_; }
+  // The protocol as run: the file's text when nothing was overridden or included, else the
+  // text with each override written in and marked ("# --set ..."), or, when it includes
+  // files, every key written out: parsing it alone gives these settings (the notebook keeps
+  // it; `rocklab rerun` runs it again; a changed material file changes its hash).
   std::string effectiveText() const;
 
  private:
@@ -128,15 +131,20 @@ class Settings {
   std::shared_ptr<const Schema> schema_;  // owned: settings outlive the schema they came from
   std::string file_, source_;
   std::map<std::string, Value> values_;
-  std::map<std::string, int> given_;           // key -> line (0: given by an override)
-  std::map<std::string, Override> overrides_;  // key -> the override that set it last
-  std::map<std::string, Value> unchosen_;      // key -> its value before runChoice()
+  std::vector<std::string> includes_;
+  std::map<std::string, int> given_;             // key -> line (0: given by an override)
+  std::map<std::string, std::string> given_in_;  // key -> the included file that gave it
+  std::map<std::string, Override> overrides_;    // key -> the override that set it last
+  std::map<std::string, Value> unchosen_;        // key -> its value before runChoice()
 };
 
 // Parses TOML text read from `file`, checks every key against the schema and returns the
 // settings; throws ProtocolError with all problems (unknown or missing keys, wrong types,
-// values out of range) each naming the file, line, key, allowed range and unit. Overrides
-// replace or add keys after the file's, validated the same way.
+// values out of range) each naming the file, line, key, allowed range and unit. A top-level
+// `include = "materials/NAME.toml"` (or a list of them; relative to `file`'s folder) adds
+// the keys of those files, checked the same way at their own lines; a key is given once,
+// in the protocol or in one included file. Overrides replace or add keys after the files',
+// validated the same way.
 Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema,
                        const std::vector<Override>& overrides = {});
 

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 
 #include "lab/protocol/declare.hpp"
@@ -281,6 +284,103 @@ TEST(Protocol, EffectiveTextReadsBackToTheSettingsWithTheOverridesMarked) {
   EXPECT_DOUBLE_EQ(mb.real("formation.axial_stress_MPa"), 30.0);
   const Settings c = parseProtocol("p.toml", multi, sc, {parseOverride("sample.count=7")});
   EXPECT_EQ(parseProtocol("p.toml", c.effectiveText(), sc).integer("sample.count"), 7);
+}
+
+// A folder with a protocol that includes a material file, written for one test.
+class Included : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("rocklab-include-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_ / "materials");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    const auto path = (dir_ / name).string();
+    std::ofstream(path) << text;
+    return path;
+  }
+  std::filesystem::path dir_;
+};
+
+constexpr const char* kMaterial = "[numerics]\nlocal_damping = 0.25\n\n[sample]\ncount = 64\n";
+
+TEST_F(Included, AMaterialFilesKeysJoinTheProtocolsCheckedAtTheirOwnLines) {
+  const Schema sc = schema();
+  write("materials/soft.toml", kMaterial);
+  const std::string text = "include = \"materials/soft.toml\"\n" + std::string(kGood);
+  const std::string file = write("p.toml", text);
+  const Settings s = parseProtocol(file, text, sc);
+  EXPECT_DOUBLE_EQ(s.real("numerics.local_damping"), 0.25);
+  EXPECT_EQ(s.integer("sample.count"), 64);
+  EXPECT_DOUBLE_EQ(s.real("formation.axial_stress_MPa"), 30.0);
+  const std::string material = (dir_ / "materials/soft.toml").string();
+  EXPECT_EQ(s.where("sample.count"), material + ":5");
+  EXPECT_EQ(s.where("formation.axial_stress_MPa"), file + ":8");
+  ASSERT_EQ(s.includes(), std::vector<std::string>{material});
+
+  // The protocol as run stands alone: the material's keys written in, so a changed material
+  // file changes the run's text (and hash), and parsing the text alone gives these settings.
+  const std::string effective = s.effectiveText();
+  EXPECT_EQ(effective.find("include ="), std::string::npos) << effective;
+  EXPECT_NE(effective.find("count = 64  # " + material), std::string::npos) << effective;
+  const Settings back = parseProtocol(file, effective, sc);
+  EXPECT_EQ(back.table().size(), s.table().size());
+  for (std::size_t k = 0; k < s.table().size(); ++k) {
+    EXPECT_EQ(back.table()[k].value, s.table()[k].value) << s.table()[k].key;
+  }
+  write("materials/soft.toml", "[sample]\ncount = 65\n");
+  EXPECT_NE(parseProtocol(file, text, sc).effectiveText(), effective);
+
+  // --set overrides an included key like any other.
+  const Settings o = parseProtocol(file, text, sc, {parseOverride("sample.count=9")});
+  EXPECT_EQ(o.integer("sample.count"), 9);
+  EXPECT_EQ(parseProtocol(file, o.effectiveText(), sc).integer("sample.count"), 9);
+}
+
+TEST_F(Included, AKeyIsGivenOnceAndABadIncludeIsNamedAtItsLine) {
+  const Schema sc = schema();
+  auto problems = [&](const std::string& text) {
+    const std::string file = write("p.toml", text);
+    try {
+      parseProtocol(file, text, sc);
+    } catch (const ProtocolError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string p = (dir_ / "p.toml").string();
+  write("materials/soft.toml", kMaterial);
+  // Given in both: named at the material's line with the protocol's place.
+  std::string e = problems("include = [\"materials/soft.toml\"]\n" + std::string(kGood) +
+                           "\n[sample]\ncount = 3\n");
+  EXPECT_NE(e.find((dir_ / "materials/soft.toml").string() +
+                   ":5: sample.count is given again: " + p + ":14 gives it too"),
+            std::string::npos)
+      << e;
+  // A key out of range in the material file: its own file and line.
+  write("materials/bad.toml", "[sample]\n\ncount = 1\n");
+  e = problems("include = \"materials/bad.toml\"\n" + std::string(kGood));
+  EXPECT_NE(e.find((dir_ / "materials/bad.toml").string() +
+                   ":3: sample.count = 1 is outside the allowed range [2, 100000000]"),
+            std::string::npos)
+      << e;
+  e = problems("include = \"materials/none.toml\"\n" + std::string(kGood));
+  EXPECT_NE(e.find(p + ":1: include: cannot read " + (dir_ / "materials/none.toml").string()),
+            std::string::npos)
+      << e;
+  e = problems("include = 3\n" + std::string(kGood));
+  EXPECT_NE(e.find(p + ":1: include expects a file or a list of files"), std::string::npos) << e;
+  write("materials/nested.toml", "include = \"soft.toml\"\n");
+  e = problems("include = \"materials/nested.toml\"\n" + std::string(kGood));
+  EXPECT_NE(e.find("may hold a material's keys only"), std::string::npos) << e;
+  write("materials/broken.toml", "[sample\n");
+  e = problems("include = \"materials/broken.toml\"\n" + std::string(kGood));
+  EXPECT_NE(
+      e.find(p + ":1: include: " + (dir_ / "materials/broken.toml").string() + ": not valid TOML"),
+      std::string::npos)
+      << e;
 }
 
 // A section of two fields and a rule across them, as a rig's loading.
