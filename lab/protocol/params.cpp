@@ -663,7 +663,7 @@ std::string Settings::effectiveText() const {
   std::vector<std::tuple<std::string, int, std::string>> edits;
   for (const auto& [key, o] : overrides_) {
     with += (with.empty() ? "" : ", ") + o.label();
-    const int line = given_.count(key) && !given_in_.count(key) ? given_.at(key) : 0;
+    const int line = given_.count(key) ? given_.at(key) : 0;
     edits.emplace_back(key, line, tomlLiteral(values.at(key)) + "  # " + o.label());
   }
   const std::string head = "# The protocol as run: " + file_ + " with " + with + "\n";
