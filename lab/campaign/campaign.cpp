@@ -7,78 +7,20 @@
 #include <fstream>
 #include <map>
 #include <sstream>
-#include <toml.hpp>
 
+#include "lab/campaign/toml_text.hpp"
 #include "rigs/registry.hpp"
 
 namespace rocklab::campaign {
 
 namespace {
 
-using TomlValue = toml::basic_value<toml::discard_comments, std::map, std::vector>;
-
-// A TOML value written back as TOML that reads to the same value (the protocol parser
-// reads the overrides): numbers in their shortest round-trip form, texts quoted.
-std::string literal(const TomlValue& v) {
-  if (v.is_floating()) {
-    const double x = v.as_floating();
-    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-    if (std::isnan(x)) return "nan";
-    char buf[32];
-    std::string t(buf, std::to_chars(buf, buf + sizeof buf, x).ptr);
-    if (t.find_first_of(".en") == std::string::npos) t += ".0";
-    return t;
-  }
-  if (v.is_integer()) return std::to_string(v.as_integer());
-  if (v.is_boolean()) return v.as_boolean() ? "true" : "false";
-  if (v.is_string()) {
-    std::string q = "\"";
-    for (char c : v.as_string().str) {
-      if (c == '"' || c == '\\') q += '\\';
-      q += c;
-    }
-    return q + "\"";
-  }
-  if (v.is_array()) {
-    std::string t = "[";
-    for (std::size_t k = 0; k < v.as_array().size(); ++k) {
-      t += (k ? ", " : "") + literal(v.as_array()[k]);
-    }
-    return t + "]";
-  }
-  return "";  // tables and dates: refused by the caller
-}
-
-class Reader {
+// A problem without a line is the file's.
+class Reader : public TomlReader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  std::string at(const TomlValue& v) const {
-    return file_ + ":" + std::to_string(v.location().line());
-  }
-  void problem(const TomlValue& v, const std::string& what) {
-    problems_.push_back(at(v) + ": " + what);
-  }
-  void problem(const std::string& what) { problems_.push_back(file_ + ": " + what); }
-  void throwIfAny() const {
-    if (!problems_.empty()) throw protocol::ProtocolError(problems_);
-  }
-  // The keys of a table and its nested tables, dotted ("loading.rate" from [set.loading]).
-  static void flatten(const TomlValue& table, const std::string& prefix,
-                      std::vector<std::pair<std::string, const TomlValue*>>& out) {
-    for (const auto& [k, v] : table.as_table()) {
-      const std::string key = prefix.empty() ? k : prefix + "." + k;
-      if (v.is_table()) {
-        flatten(v, key, out);
-      } else {
-        out.emplace_back(key, &v);
-      }
-    }
-  }
-
- private:
-  std::string file_;
-  std::vector<std::string> problems_;
+  using TomlReader::problem;
+  using TomlReader::TomlReader;
+  void problem(const std::string& what) { TomlReader::problem(file() + ": " + what); }
 };
 
 std::string readText(const std::string& path) {
@@ -129,44 +71,6 @@ void readHead(const TomlValue& t, Campaign& c, Reader& r, const TomlValue*& seed
   if (c.name.empty() && t.as_table().count("name") == 0) r.problem("missing campaign.name");
   if (c.protocol.empty() && t.as_table().count("protocol") == 0) {
     r.problem("missing campaign.protocol: the protocol file the campaign runs");
-  }
-}
-
-void readSlurm(const TomlValue& t, SlurmOptions& s, Reader& r) {
-  for (const auto& [k, v] : t.as_table()) {
-    auto text = [&](std::string& out) {
-      if (v.is_string()) {
-        out = v.as_string().str;
-      } else {
-        r.problem(v, "slurm." + k + ": a text");
-      }
-    };
-    if (k == "partition") {
-      text(s.partition);
-    } else if (k == "time") {
-      text(s.time);
-    } else if (k == "account") {
-      text(s.account);
-    } else if (k == "cpus_per_task") {
-      if (!v.is_integer() || v.as_integer() < 1 || v.as_integer() > 1024) {
-        r.problem(v, "slurm.cpus_per_task: an integer in [1, 1024]");
-      } else {
-        s.cpus_per_task = static_cast<int>(v.as_integer());
-      }
-    } else if (k == "options") {
-      bool texts = v.is_array();
-      if (texts) {
-        for (const auto& o : v.as_array()) texts = texts && o.is_string();
-      }
-      if (!texts) {
-        r.problem(v, "slurm.options: a list of sbatch options, e.g. [\"--mem=2G\"]");
-      } else {
-        for (const auto& o : v.as_array()) s.options.push_back(o.as_string().str);
-      }
-    } else {
-      r.problem(v, "slurm." + k +
-                       ": unknown key (slurm.partition, time, account, cpus_per_task, options)");
-    }
   }
 }
 
@@ -227,7 +131,7 @@ Campaign readCampaign(const std::string& path) {
     } else if (k == "sweep") {
       Reader::flatten(v, "", sweeps);
     } else if (k == "slurm") {
-      readSlurm(v, c.slurm, r);
+      r.slurm(v, c.slurm);
     } else {
       r.problem(v, "[" + k + "]: unknown table ([campaign], [set], [sweep], [slurm])");
     }
@@ -246,7 +150,7 @@ Campaign readCampaign(const std::string& path) {
     c.protocol = (fs::path(path).parent_path() / c.protocol).lexically_normal().string();
   }
   for (const auto& [key, v] : fixed) {
-    const std::string text = literal(*v);
+    const std::string text = tomlLiteral(*v);
     if (text.empty()) {
       r.problem(*v, "set." + key + ": a number, text, boolean or list");
     } else {
@@ -262,7 +166,7 @@ Campaign readCampaign(const std::string& path) {
     }
     std::vector<protocol::Override> list;
     for (const auto& e : v->as_array()) {
-      const std::string text = literal(e);
+      const std::string text = tomlLiteral(e);
       if (text.empty()) {
         r.problem(e, "sweep." + key + ": a value is a table or date, not a protocol value");
       } else {
@@ -339,6 +243,96 @@ Campaign readCampaign(const std::string& path) {
 
   r.throwIfAny();
   return c;
+}
+
+std::string numberText(double x) {
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  if (std::isnan(x)) return "nan";
+  char buf[32];
+  std::string t(buf, std::to_chars(buf, buf + sizeof buf, x).ptr);
+  if (t.find_first_of(".en") == std::string::npos) t += ".0";
+  return t;
+}
+
+std::string tomlLiteral(const TomlValue& v) {
+  if (v.is_floating()) return numberText(v.as_floating());
+  if (v.is_integer()) return std::to_string(v.as_integer());
+  if (v.is_boolean()) return v.as_boolean() ? "true" : "false";
+  if (v.is_string()) {
+    std::string q = "\"";
+    for (char c : v.as_string().str) {
+      if (c == '"' || c == '\\') q += '\\';
+      q += c;
+    }
+    return q + "\"";
+  }
+  if (v.is_array()) {
+    std::string t = "[";
+    for (std::size_t k = 0; k < v.as_array().size(); ++k) {
+      const std::string e = tomlLiteral(v.as_array()[k]);
+      if (e.empty()) return "";
+      t += (k ? ", " : "") + e;
+    }
+    return t + "]";
+  }
+  return "";  // tables and dates: refused by the caller
+}
+
+void readSlurmTable(const TomlValue& t, const std::string& file, SlurmOptions& s,
+                    std::vector<std::string>& problems) {
+  for (const auto& [k, v] : t.as_table()) {
+    auto problem = [&](const std::string& what) {
+      problems.push_back(file + ":" + std::to_string(v.location().line()) + ": slurm." + k + ": " +
+                         what);
+    };
+    auto text = [&](std::string& out) {
+      if (v.is_string()) {
+        out = v.as_string().str;
+      } else {
+        problem("a text");
+      }
+    };
+    if (k == "partition") {
+      text(s.partition);
+    } else if (k == "time") {
+      text(s.time);
+    } else if (k == "account") {
+      text(s.account);
+    } else if (k == "cpus_per_task") {
+      if (!v.is_integer() || v.as_integer() < 1 || v.as_integer() > 1024) {
+        problem("an integer in [1, 1024]");
+      } else {
+        s.cpus_per_task = static_cast<int>(v.as_integer());
+      }
+    } else if (k == "options") {
+      bool texts = v.is_array();
+      if (texts) {
+        for (const auto& o : v.as_array()) texts = texts && o.is_string();
+      }
+      if (!texts) {
+        problem("a list of sbatch options, e.g. [\"--mem=2G\"]");
+      } else {
+        for (const auto& o : v.as_array()) s.options.push_back(o.as_string().str);
+      }
+    } else {
+      problem("unknown key (slurm.partition, time, account, cpus_per_task, options)");
+    }
+  }
+}
+
+std::string slurmTableText(const SlurmOptions& s) {
+  auto quoted = [](const std::string& x) { return tomlLiteral(TomlValue(x)); };
+  std::string t;
+  if (!s.partition.empty()) t += "partition = " + quoted(s.partition) + "\n";
+  if (!s.time.empty()) t += "time = " + quoted(s.time) + "\n";
+  if (!s.account.empty()) t += "account = " + quoted(s.account) + "\n";
+  if (s.cpus_per_task > 0) t += "cpus_per_task = " + std::to_string(s.cpus_per_task) + "\n";
+  if (!s.options.empty()) {
+    t += "options = [";
+    for (std::size_t k = 0; k < s.options.size(); ++k) t += (k ? ", " : "") + quoted(s.options[k]);
+    t += "]\n";
+  }
+  return t.empty() ? t : "[slurm]\n" + t;
 }
 
 }  // namespace rocklab::campaign
