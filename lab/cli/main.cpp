@@ -8,6 +8,7 @@
 
 #include "lab/cli/bench.hpp"
 #include "lab/cli/build_info.hpp"
+#include "lab/cli/calibrate_commands.hpp"
 #include "lab/cli/campaign_commands.hpp"
 #include "lab/cli/lab_commands.hpp"
 #include "lab/cli/study_commands.hpp"
@@ -499,6 +500,25 @@ void addPack(CLI::App& app, Action& action) {
   });
 }
 
+void addCalibrate(CLI::App& app, Action& action) {
+  auto o = std::make_shared<rocklab::cli::CalibrateOptions>();
+  auto* c = app.add_subcommand(
+      "calibrate",
+      "Fit protocol keys to measured properties: batches of evaluations over seeds, each a "
+      "campaign (local pool or Slurm), resumed from the lab by running it again");
+  c->add_option("calibration", o->file, "Calibration file (TOML)")->required();
+  c->add_option("--lab", o->lab, "Lab notebook (SQLite)");
+  c->add_option("--jobs", o->jobs, "Local pool: runs at once (default: cores / threads)")
+      ->check(CLI::Range(1, 4096));
+  c->add_option("--scheduler", o->scheduler, "local (a pool of processes) or slurm (sbatch)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  c->add_option("--report", o->report,
+                "The report's folder (default: <lab>.calibrations/NAME/report)");
+  c->add_flag("--check", o->check_only, "Validate the file and its protocols; run nothing");
+  c->add_flag("--quiet", o->quiet, "No progress lines from the campaigns");
+  c->callback([&action, o] { action = [o] { return rocklab::cli::calibrate(*o); }; });
+}
+
 void addCampaign(CLI::App& app, Action& action) {
   auto o = std::make_shared<rocklab::cli::CampaignOptions>();
   auto* c = app.add_subcommand(
@@ -576,6 +596,7 @@ int main(int argc, char** argv) {
   addRegress(app, action);
   addPack(app, action);
   addCampaign(app, action);
+  addCalibrate(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

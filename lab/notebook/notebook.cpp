@@ -264,6 +264,42 @@ CREATE TABLE campaign_statistics (
   PRIMARY KEY (campaign_id, point, name)
 );
 )sql",
+      // 7 -> 8: calibrations, each evaluation's parameters and targets (lab/calibration).
+      R"sql(
+CREATE TABLE calibrations (
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL UNIQUE,
+  file TEXT NOT NULL,
+  text TEXT NOT NULL,
+  status TEXT NOT NULL,
+  reason TEXT,
+  best_evaluation INTEGER,
+  material TEXT,
+  updated TEXT NOT NULL
+);
+CREATE TABLE calibration_evaluations (
+  calibration_id INTEGER NOT NULL REFERENCES calibrations(id) ON DELETE CASCADE,
+  evaluation INTEGER NOT NULL,
+  batch INTEGER NOT NULL,
+  kind TEXT NOT NULL,
+  status TEXT NOT NULL,
+  misfit REAL,
+  within_tolerance INTEGER,
+  PRIMARY KEY (calibration_id, evaluation)
+);
+CREATE TABLE calibration_values (
+  calibration_id INTEGER NOT NULL REFERENCES calibrations(id) ON DELETE CASCADE,
+  evaluation INTEGER NOT NULL,
+  role TEXT NOT NULL,
+  name TEXT NOT NULL,
+  value REAL,
+  n INTEGER,
+  std REAL,
+  ci95_low REAL,
+  ci95_high REAL,
+  PRIMARY KEY (calibration_id, evaluation, role, name)
+);
+)sql",
   };
   return m;
 }

@@ -16,7 +16,7 @@
 
 namespace rocklab::notebook {
 
-inline constexpr int kSchemaVersion = 7;
+inline constexpr int kSchemaVersion = 8;
 
 // Opens a lab notebook, creating it if needed, and brings its schema up to date. Runs a
 // previous process left `running` on this host and that process is gone are marked failed.

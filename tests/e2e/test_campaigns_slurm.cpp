@@ -150,5 +150,39 @@ TEST_F(SlurmCluster, ATaskCancelledByTheSchedulerIsReportedAndResumed) {
   removeLabFiles(reference);
 }
 
+// A calibration's batches as job arrays: each evaluation's runs made by Slurm, merged, and
+// its target read from them.
+TEST_F(SlurmCluster, ACalibrationRunsItsBatchesAsJobArrays) {
+  Lab lab("slurm-calibration");
+  const std::string file = lab.path + ".calibration.toml";
+  std::ofstream(file) << "[calibration]\nname = \"slurm-cement\"\nbudget = 4\nbatch = 2\nseeds = "
+                         "2\n\n[set]\n\"sample.count\" = 60\n\n[[target]]\nprotocol = \""
+                      << sourceDir()
+                      << "/protocols/biaxial-ucs-quick.toml\"\nresult = \"ucs_MPa\"\nvalue = "
+                         "6.0\ntolerance_percent = 10\n\n[[parameter]]\nkey = "
+                         "\"bonds.tensile_strength_mean_MPa\"\nlow = 5.0\nhigh = 100.0\nscale = "
+                         "\"log\"\nstart = 16.5\n\n[slurm]\npartition = \"debug\"\ntime = "
+                         "\"00:10:00\"\n";
+  std::string out;
+  const int code = runRocklab("calibrate " + file + " --scheduler slurm --lab " + lab.path, &out);
+  EXPECT_TRUE(code == 0 || code == 1) << out;
+  EXPECT_NE(out.find("submitted as Slurm job array"), std::string::npos) << out;
+  // Every evaluation of the first batch evaluated from two runs Slurm made.
+  EXPECT_EQ(rows(lab.path,
+                 "SELECT count(*) FROM calibration_evaluations WHERE batch = 0 AND status = "
+                 "'evaluated'"),
+            std::vector<std::string>{"4|"});
+  EXPECT_EQ(rows(lab.path,
+                 "SELECT count(*) = (SELECT count(*) FROM runs WHERE status = 'completed') FROM "
+                 "run_origins WHERE scheduler = 'slurm' AND job_id IS NOT NULL"),
+            std::vector<std::string>{"1|"});
+  EXPECT_EQ(
+      rows(lab.path, "SELECT count(*) FROM calibration_values WHERE role = 'target' AND n = 2"),
+      rows(lab.path, "SELECT count(*) FROM calibration_evaluations WHERE status = 'evaluated'"));
+  fs::remove(file);
+  removeLabFiles(lab);
+  fs::remove_all(lab.path + ".calibrations");
+}
+
 }  // namespace
 }  // namespace rocklab::testing
