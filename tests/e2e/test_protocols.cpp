@@ -1018,9 +1018,27 @@ TEST(QuickProtocols, HydrostaticPermeabilityFollowsKozenyCarman3D) {
   Lab lab("permeameter-3d");
   auto n = runQuick(lab, "permeameter-hydrostatic-3d-quick");
   expectSoundFlow(n);
-  EXPECT_NEAR(result(n, "permeability_initial_m2") / result(n, "kozeny_carman_initial_m2"), 1.0,
-              1e-9);
-  EXPECT_GT(result(n, "conductance_alpha"), 0.0);
+  // The network's k0 is Kozeny-Carman's on another sample too, with the alpha this one
+  // calibrated (section 3.5.3: alpha is a property of the network model, not of one
+  // packing). Measured with seed 12's alpha on seeds 13-17: k0 / Kozeny-Carman 1.013, 1.002,
+  // 1.061, 0.994, 1.021 (mean 1.018, sd 0.026); 10% is about three sd past the mean.
+  const double alpha = result(n, "conductance_alpha");
+  Lab other("permeameter-3d-other");
+  std::string out;
+  ASSERT_EQ(rocklab::testing::runRocklab(
+                "run " + sourceDir() +
+                    "/protocols/permeameter-hydrostatic-3d-quick.toml --quiet --threads 1"
+                    " --set protocol.seed=13 --set flow.calibrate_alpha=false"
+                    " --set flow.explicit_max_steps=1000 --set flow.conductance_alpha=" +
+                    std::to_string(alpha) + " --lab " + other.path,
+                &out),
+            0)
+      << out;
+  nb::Notebook m(other.path);
+  // It ran on the alpha given (a calibrated alpha would make the ratio 1 by construction).
+  ASSERT_EQ(result(m, "conductance_alpha"), std::stod(std::to_string(alpha)));
+  EXPECT_NEAR(result(m, "permeability_initial_m2") / result(m, "kozeny_carman_initial_m2"), 1.0,
+              0.10);
   EXPECT_LT(result(n, "k_over_k0_final"), 0.85);
   EXPECT_LT(largestGap(n, "k_over_k0", "kozeny_carman_over_k0"), 0.06);
   // The pore pressure field (Figure 11) is in the notebook, every pore before and after.
@@ -1040,7 +1058,16 @@ TEST(QuickProtocols, PlaneStrainPermeabilityFollowsKozenyCarman2D) {
   Lab lab("permeameter-2d");
   auto n = runQuick(lab, "permeameter-plane-strain-2d-quick");
   expectSoundFlow(n);
-  EXPECT_EQ(result(n, "kozeny_carman_porosity_initial"), 0.30);
+  // The Kozeny-Carman curve is equation 8 on the paper's assumed 30%, carried by the
+  // sample's volume: phi = 1 - 0.7 V0 / V, recomputed here from the volumetric strain.
+  const std::vector<double> strain = seriesValues(n, "flow.volumetric_strain");
+  const std::vector<double> kc = seriesValues(n, "kozeny_carman_over_k0");
+  ASSERT_EQ(strain.size(), kc.size());
+  ASSERT_GT(strain.back(), 0.01);  // the loading compacts the sample (measured 3.1%)
+  for (std::size_t i = 0; i < kc.size(); ++i) {
+    const double phi = 1.0 - 0.7 / (1.0 - strain[i]);
+    EXPECT_NEAR(kc[i], std::pow(phi / 0.3, 3) * std::pow(0.7 / (1.0 - phi), 2), 1e-9) << i;
+  }
   EXPECT_LT(result(n, "k_over_k0_final"), 0.9);
   EXPECT_LT(largestGap(n, "k_over_k0", "kozeny_carman_over_k0"), 0.06);
 }
@@ -1107,7 +1134,9 @@ TEST(QuickProtocols, UltrasonicVelocitiesRiseWithHydrostaticStress) {
     const std::vector<double> x = seriesValues(n, v);
     ASSERT_EQ(x.size(), 3u) << v;
     EXPECT_GT(x.back(), 1.03 * x.front()) << v;
-    EXPECT_NEAR(result(n, v), x.back(), 1e-9) << v;  // the last stage's, as results
+    // At most Hertz's rise, v ~ sigma^(1/6) (effective medium, fixed coordination: K, G ~
+    // sigma^(1/3)); the cement in parallel flattens it (measured: 0.046 for vp_z).
+    EXPECT_LT(std::log(x.back() / x.front()) / std::log(8.0 / 0.5), 1.0 / 6.0) << v;
   }
   EXPECT_NEAR(result(n, "vp_x") / result(n, "vp_z"), 1.0, 0.15);
   EXPECT_NEAR(result(n, "vs_xy") / result(n, "vs_zx"), 1.0, 0.15);
