@@ -44,6 +44,14 @@ def ensure(program, packages):
                            *packages], check=True)
 
 
+def check_runs_and_binary(a):
+    """At least three runs (--runs) of a built rocklab (--rocklab)."""
+    if a.runs < 3:
+        sys.exit("--runs: at least 3 (medians of fewer say little on a shared machine)")
+    if not os.access(a.rocklab, os.X_OK):
+        sys.exit(a.rocklab + ": build rocklab first (make build)")
+
+
 def plain(packing, tmp):
     """The packing file itself, or its decompressed copy in tmp when it ends in .xz."""
     if not packing.endswith(".xz"):
@@ -96,10 +104,7 @@ def main():
     ap.add_argument("--steps", type=int, default=2000)
     ap.add_argument("--rocklab", default=os.path.join(ROOT, "build", "release", "rocklab"))
     a = ap.parse_args()
-    if a.runs < 3:
-        sys.exit("--runs: at least 3 (medians of fewer say little on a shared machine)")
-    if not os.access(a.rocklab, os.X_OK):
-        sys.exit(a.rocklab + ": build rocklab first (make build)")
+    check_runs_and_binary(a)
     ensure("liggghts", ["liggghts", "openmpi-bin"])
     if a.yade:
         ensure("yade", ["yade"])

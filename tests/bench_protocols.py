@@ -4,6 +4,7 @@
   tests/bench_protocols.py --old OLD/rocklab [--old-source OLD] [--new build/release/rocklab]
                            [--protocols hydrostatic-quick,biaxial-ucs-quick,...]
                            [--repeat 3] [--threads 2] [--out build/bench-protocols]
+                           [--stages flow]
 
 Each protocol (default: every protocols/*-quick.toml) runs --repeat times with each binary,
 the two alternating (old first, then new first, and so on, so that a drift of the machine
@@ -14,7 +15,9 @@ of each binary (the process's, what a user waits for), their ratio old / new, an
 result of the new binary's last run against the seed scatter of the protocol's regression
 reference (tests/reference/<protocol>.toml holds its values at three seeds): inside when it
 lies in the 95% prediction interval of one more seed, mean +- t(0.975, n - 1) s sqrt(1 + 1/n).
-A result the reference does not guard is listed as such.
+A result the reference does not guard is listed as such. With --stages PREFIX, also the
+median seconds of each stage timing of the notebook whose name starts with PREFIX (for
+example the permeameter's flow, flow_network and flow_solve), for each binary.
 
 Build the old binary from the commit to compare with, for example
   git worktree add /tmp/old 7434d0b && cmake -S /tmp/old -B /tmp/old/build -G Ninja
@@ -27,6 +30,7 @@ import glob
 import math
 import os
 import shutil
+import sqlite3
 import statistics
 import subprocess
 import time
@@ -57,6 +61,14 @@ def timed_run(binary, protocol, threads, lab):
         raise SystemExit("%s %s failed (%d):\n%s" % (binary, protocol, done.returncode,
                                                      done.stderr[-2000:]))
     return seconds
+
+
+def stage_timings(lab, prefix):
+    """Seconds of the stage timings of run 1 whose stage name starts with prefix."""
+    with sqlite3.connect(lab) as db:
+        rows = db.execute("SELECT stage, seconds FROM stage_timings WHERE run_id = 1 AND "
+                          "substr(stage, 1, length(?)) = ?", (prefix, prefix)).fetchall()
+    return dict(rows)
 
 
 def key_results(binary, lab):
@@ -123,6 +135,8 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--out", default=os.path.join(SOURCE, "build", "bench-protocols"))
+    ap.add_argument("--stages", default="",
+                    help="also the median stage timings whose names start with this")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     if a.protocols:
@@ -135,16 +149,24 @@ def main():
         protocol = {"old": os.path.join(a.old_source, "protocols", name + ".toml"),
                     "new": os.path.join(SOURCE, "protocols", name + ".toml")}
         times = {"old": [], "new": []}
+        stages = {"old": {}, "new": {}}
         for k in range(a.repeat):
             order = ["old", "new"] if k % 2 == 0 else ["new", "old"]
             for which in order:
                 binary = a.old if which == "old" else a.new
                 lab = os.path.join(a.out, "%s-%s.sqlite" % (name, which))
                 times[which].append(timed_run(binary, protocol[which], a.threads, lab))
+                if a.stages:
+                    for stage, seconds in stage_timings(lab, a.stages).items():
+                        stages[which].setdefault(stage, []).append(seconds)
         old, new = statistics.median(times["old"]), statistics.median(times["new"])
         ratios.append(old / new)
         print("%s: old %.1f s, new %.1f s (medians of %d, %d threads): %.2fx"
               % (name, old, new, a.repeat, a.threads, old / new), flush=True)
+        for stage in sorted(set(stages["old"]) | set(stages["new"])):
+            o, n = (statistics.median(stages[w][stage]) if stages[w].get(stage) else float("nan")
+                    for w in ("old", "new"))
+            print("  stage %s: old %.3f s, new %.3f s" % (stage, o, n))
         reference = reference_of(name)
         for key, value in key_results(a.new, os.path.join(a.out, name + "-new.sqlite")).items():
             shown = "not recorded" if value is None else "%.6g" % value

@@ -248,7 +248,25 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
   return r;
 }
 
-FlowBenchResult runFlowBench(const Packing<3>& packing) {
+namespace {
+
+FlowCall flowCall(const flow::FlowReading& r) {
+  FlowCall c;
+  c.network_seconds = r.network_seconds;
+  c.solve_seconds = r.solve.seconds;
+  c.assembly_seconds = r.solve.assembly_seconds;
+  c.analysis_seconds = r.solve.analysis_seconds;
+  c.factorisation_seconds = r.solve.factorisation_seconds;
+  c.iteration_seconds = r.solve.solve_seconds;
+  c.path = flow::describe(r.solve.path);
+  c.iterations = r.solve.iterations;
+  c.permeability = r.permeability;
+  return c;
+}
+
+}  // namespace
+
+FlowBenchResult runFlowBench(const Packing<3>& packing, double strain) {
   SimulationConfig cfg;
   cfg.contact_law = "hertz";
   cfg.track_energy = false;
@@ -257,17 +275,29 @@ FlowBenchResult runFlowBench(const Packing<3>& packing) {
   settings.merge.small_pore_ratio = 0.0;  // as Yade's FlowEngine: every cell a pore
   flow::FlowCoupling<3> coupling{settings};
   const flow::FlowReading first = coupling.measure(sim);
-  const flow::FlowReading repeat = coupling.measure(sim);
+  Packing<3> moved = packing;
+  const double mid = 0.5 * (packing.lo[2] + packing.hi[2]);
+  for (auto& x : moved.centers) x[2] = mid + (x[2] - mid) * (1.0 - strain);
+  const flow::FlowReading repeat = coupling.measure(makeScene(moved, kFriction, cfg));
   FlowBenchResult r;
   r.particles = packing.centers.size();
   r.pores = first.pores;
   r.pipes = first.pipes;
   r.clusters = first.clusters;
-  r.first_network_seconds = first.network_seconds;
-  r.first_solve_seconds = first.solve.seconds;
-  r.repeat_network_seconds = repeat.network_seconds;
-  r.repeat_solve_seconds = repeat.solve.seconds;
-  r.permeability = first.permeability;
+  r.strain = strain;
+  r.first = flowCall(first);
+  r.repeat = flowCall(repeat);
+  flow::ImplicitSettings fresh_settings = settings.implicit;
+  fresh_settings.reuse_factor = false;
+  const flow::SteadyFlow fresh =
+      flow::solveImplicit(coupling.clusters(), settings.pressures, fresh_settings, {});
+  r.fresh_solve_seconds = fresh.seconds;
+  const double drop = settings.pressures.inlet - settings.pressures.outlet;
+  for (std::size_t i = 0; i < fresh.pressure.size(); ++i) {
+    r.repeat_max_difference = std::max(
+        r.repeat_max_difference, std::abs(fresh.pressure[i] - repeat.solve.pressure[i]) / drop);
+  }
+  r.repeat_permeability_difference = std::abs(repeat.solve.inflow / fresh.inflow - 1.0);
   // Kozeny-Carman with the constant 180 (the peers' reference): k = d^2 n^3 / (180 (1-n)^2),
   // d the mean diameter, n the porosity of the box.
   double solid = 0.0, diameter = 0.0;
@@ -329,14 +359,26 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
           << r.state_hash << std::dec << "\"}" << (k + 1 < results.size() ? "," : "") << "\n";
     }
     out << "  ]";
+    auto call = [&](const FlowCall& c) {
+      out << "{\"network_seconds\": " << c.network_seconds
+          << ", \"solve_seconds\": " << c.solve_seconds
+          << ", \"assembly_seconds\": " << c.assembly_seconds
+          << ", \"analysis_seconds\": " << c.analysis_seconds
+          << ", \"factorisation_seconds\": " << c.factorisation_seconds
+          << ", \"iteration_seconds\": " << c.iteration_seconds << ", \"path\": \"" << c.path
+          << "\", \"iterations\": " << c.iterations << ", \"permeability_m2\": " << c.permeability
+          << "}";
+    };
     for (const FlowBenchResult& f : flow) {
       out << ",\n  \"flow\": {\"particles\": " << f.particles << ", \"pores\": " << f.pores
           << ", \"pipes\": " << f.pipes << ", \"clusters\": " << f.clusters
-          << ", \"first_network_seconds\": " << f.first_network_seconds
-          << ", \"first_solve_seconds\": " << f.first_solve_seconds
-          << ", \"repeat_network_seconds\": " << f.repeat_network_seconds
-          << ", \"repeat_solve_seconds\": " << f.repeat_solve_seconds
-          << ", \"permeability_m2\": " << f.permeability
+          << ", \"strain\": " << f.strain << ", \"first\": ";
+      call(f.first);
+      out << ", \"repeat\": ";
+      call(f.repeat);
+      out << ", \"fresh_solve_seconds\": " << f.fresh_solve_seconds
+          << ", \"repeat_max_difference\": " << f.repeat_max_difference
+          << ", \"repeat_permeability_difference\": " << f.repeat_permeability_difference
           << ", \"kozeny_carman_m2\": " << f.kozeny_carman
           << ", \"peak_rss_bytes\": " << f.peak_rss_bytes << "}";
     }
@@ -373,14 +415,25 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
         << std::setw(7) << r.coordination_end << std::setw(20) << stress.str() << std::setw(10)
         << r.rebuilds << std::setw(13) << rss.str() << std::hex << r.state_hash << std::dec << "\n";
   }
+  auto call = [&](const char* name, const FlowCall& c) {
+    out << "  " << name << ": network " << c.network_seconds << " s, solve " << c.solve_seconds
+        << " s (" << c.path << ": assembly " << c.assembly_seconds << " s, analysis "
+        << c.analysis_seconds << " s, factor " << c.factorisation_seconds << " s, "
+        << (c.iterations > 0 ? std::to_string(c.iterations) + " iterations " : "solve ")
+        << c.iteration_seconds << " s), total " << c.network_seconds + c.solve_seconds
+        << " s, k = " << c.permeability << " m^2\n";
+  };
   for (const FlowBenchResult& f : flow) {
     out << std::defaultfloat << std::setprecision(4) << "pore network on " << f.particles
         << " spheres: " << f.pores << " pores, " << f.pipes << " pipes, " << f.clusters
-        << " clusters after merging\n  first call: triangulation + network "
-        << f.first_network_seconds << " s, solve " << f.first_solve_seconds
-        << " s\n  repeat call: network " << f.repeat_network_seconds << " s, solve "
-        << f.repeat_solve_seconds << " s\n  k = " << f.permeability << " m^2, Kozeny-Carman (180) "
-        << f.kozeny_carman << " m^2, ratio " << f.permeability / f.kozeny_carman << "\n";
+        << " clusters after merging\n";
+    call("first call", f.first);
+    out << "  then every centre moved by an axial strain of " << f.strain << "\n";
+    call("repeat call", f.repeat);
+    out << "  the moved network factorised anew instead: solve " << f.fresh_solve_seconds
+        << " s; largest pressure difference " << f.repeat_max_difference << " of the drop, inflow "
+        << f.repeat_permeability_difference << " relative\n  Kozeny-Carman (180) "
+        << f.kozeny_carman << " m^2, k / KC " << f.first.permeability / f.kozeny_carman << "\n";
   }
   for (const RenderBenchResult& g : render) {
     out << std::defaultfloat << std::setprecision(4) << "snapshot of " << g.particles

@@ -27,6 +27,7 @@ struct BenchOptions {
   bool scalar_bonds = false;         // bonds one at a time, not four per AVX register (same bits)
   bool bonded = false;               // a parallel bond on every initial contact (cemented rock)
   bool flow = false;                 // also time the pore network and a steady solve on the packing
+  double flow_strain = 1e-4;         // axial strain of the packing before the repeat flow call
   bool render = false;               // also time an off-screen snapshot of the packing
   std::string render_dir = ".";      // where the snapshot's PNGs go
 };
@@ -49,14 +50,29 @@ struct BenchResult {
   double peak_rss_bytes = 0.0;  // of the process so far (getrusage)
 };
 
-// The pore network on the packing (as Yade's FlowEngine builds it): the first
-// call triangulates, measures the network and solves; the repeat call, on the same
-// positions, measures and solves again.
+// One call of the pore network: measured (and triangulated on the first call), then solved.
+struct FlowCall {
+  double network_seconds = 0.0;  // triangulation (first call) and the network's measurement
+  double solve_seconds = 0.0;    // the whole solve, of which:
+  double assembly_seconds = 0.0, analysis_seconds = 0.0;
+  double factorisation_seconds = 0.0, iteration_seconds = 0.0;
+  std::string path;  // how the solve was reached (flow::describe)
+  std::size_t iterations = 0;
+  double permeability = 0.0;  // m^2
+};
+
+// The pore network on the packing (as Yade's FlowEngine builds it): the first call
+// triangulates, measures the network and solves; the repeat call, after every centre moved
+// by an axial strain along the flow (z) about the mid-height, measures the network on the
+// moved particles (no new triangulation) and solves it, keeping what the first solve left.
+// The repeat's pressures are held against a fresh factorisation of the same moved network.
 struct FlowBenchResult {
   std::size_t particles = 0, pores = 0, pipes = 0, clusters = 0;
-  double first_network_seconds = 0.0, first_solve_seconds = 0.0;
-  double repeat_network_seconds = 0.0, repeat_solve_seconds = 0.0;
-  double permeability = 0.0;   // m^2
+  double strain = 0.0;
+  FlowCall first, repeat;
+  double fresh_solve_seconds = 0.0;             // the moved network factorised anew instead
+  double repeat_max_difference = 0.0;           // largest pore pressure difference from it / drop
+  double repeat_permeability_difference = 0.0;  // relative
   double kozeny_carman = 0.0;  // m^2, for the same porosity and mean diameter (constant 180)
   double peak_rss_bytes = 0.0;
 };
@@ -80,7 +96,7 @@ Packing<3> benchPacking(std::size_t n, std::uint64_t seed, int threads);
 Packing<3> tilePacking(const Packing<3>& packing, const std::array<int, 3>& tile);
 
 BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int threads);
-FlowBenchResult runFlowBench(const Packing<3>& packing);
+FlowBenchResult runFlowBench(const Packing<3>& packing, double strain);
 RenderBenchResult runRenderBench(const Packing<3>& packing, const std::string& folder);
 
 // Peak resident memory of this process so far (bytes).

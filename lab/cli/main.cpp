@@ -57,7 +57,7 @@ int runBenchCommand(rocklab::BenchOptions o, bool json) {
   std::vector<BenchResult> results;
   std::vector<FlowBenchResult> flow;
   std::vector<RenderBenchResult> render;
-  if (o.flow) flow.push_back(runFlowBench(packing));
+  if (o.flow) flow.push_back(runFlowBench(packing, o.flow_strain));
   if (o.render) render.push_back(runRenderBench(packing, o.render_dir));
   if (!o.flow && !o.render) {
     for (int t : o.threads) results.push_back(runBench(packing, o, t));
@@ -201,6 +201,9 @@ void addBench(CLI::App& app, Action& action) {
               "Bonds one at a time instead of four per AVX register (the same bits, slower)");
   b->add_flag("--flow", o->flow,
               "Time the pore network (triangulation, network, steady solve) instead");
+  b->add_option("--flow-strain", o->flow_strain,
+                "Axial strain of the packing before the repeat flow call (moves the network)")
+      ->check(CLI::Range(0.0, 0.01));
   b->add_flag("--render", o->render,
               "Time an off-screen snapshot (bench-view.png, bench-slice.png) instead");
   b->add_option("--render-dir", o->render_dir, "Folder of the snapshot's PNGs")

@@ -161,7 +161,7 @@ FlowReading FlowCoupling<D>::measure(const Simulation<D>& sim) {
   }
   FlowReading r;
   r.solve = settings_.solver == FlowSolver::Implicit
-                ? solveImplicit(clusters, settings_.pressures, settings_.implicit, start)
+                ? implicit_.solve(clusters, settings_.pressures, settings_.implicit, start)
                 : solveExplicit(clusters, settings_.pressures, settings_.explicit_scheme, start);
   pore_pressure_.resize(net.pores());
   for (std::size_t c = 0; c < net.pores(); ++c) {

@@ -116,6 +116,8 @@ class FlowCoupling {
   void setAlpha(double alpha) { settings_.law.alpha = alpha; }
   double lastPermeability() const { return last_permeability_; }
   const Network<D>& network() const { return *network_; }
+  // The clusters and pipes of the last update, as the solver saw them.
+  const Clusters& clusters() const { return clusters_; }
   // Pressure of each pore of the last update (Pa).
   const std::vector<double>& porePressure() const { return pore_pressure_; }
   const std::vector<PoreBoundary>& poreBoundary() const { return boundary_; }
@@ -140,6 +142,8 @@ class FlowCoupling {
     if (has_network) ar("network", *network_);
     ar("slots", slots_), ar("built_at", built_at_), ar("pack", pack_);
     ar("boundary", boundary_), ar("pore_pressure", pore_pressure_), ar("clusters", clusters_);
+    ar("implicit", implicit_);
+    if constexpr (Archive::kReading) implicit_.restore(clusters_);
     ar("mean_radius", mean_radius_), ar("inlet_level", inlet_level_);
     ar("outlet_level", outlet_level_), ar("last_permeability", last_permeability_);
     ar("triangulations", triangulations_), ar("hidden", hidden_);
@@ -160,6 +164,7 @@ class FlowCoupling {
   std::vector<PoreBoundary> boundary_;
   std::vector<double> pore_pressure_;
   Clusters clusters_;
+  ImplicitSolver implicit_;  // keeps the last factor from one update to the next
   double mean_radius_ = 0.0, inlet_level_ = 0.0, outlet_level_ = 0.0;
   double last_permeability_ = 0.0;
   std::size_t triangulations_ = 0, hidden_ = 0;

@@ -300,9 +300,17 @@ Clusters mergePores(const Network<D>& net, const std::vector<PoreBoundary>& boun
   }
   c.volume.assign(c.count, 0.0);
   c.boundary.assign(c.count, PoreBoundary::Free);
+  c.position.assign(c.count, {0.0, 0.0, 0.0});
+  std::vector<double> pores(c.count, 0.0);
   for (std::size_t i = 0; i < net.pores(); ++i) {
-    c.volume[c.of_pore[i]] += net.volume()[i];
-    if (boundary[i] != PoreBoundary::Free) c.boundary[c.of_pore[i]] = boundary[i];
+    const auto k = c.of_pore[i];
+    c.volume[k] += net.volume()[i];
+    if (boundary[i] != PoreBoundary::Free) c.boundary[k] = boundary[i];
+    for (int d = 0; d < D; ++d) c.position[k][d] += net.centroid()[i][d];
+    pores[k] += 1.0;
+  }
+  for (std::size_t k = 0; k < c.count; ++k) {
+    for (auto& x : c.position[k]) x /= pores[k];
   }
   for (std::size_t k = 0; k < net.pipes(); ++k) {
     const auto a = c.of_pore[net.pipeA(k)], b = c.of_pore[net.pipeB(k)];

@@ -119,12 +119,14 @@ struct Clusters {
   // Pipes between different clusters: ends and conductance (parallel pipes stay apart).
   std::vector<std::uint32_t> edge_a, edge_b;
   std::vector<double> edge_conductance;
-  std::vector<double> volume;          // m^3 per cluster
-  std::vector<PoreBoundary> boundary;  // per cluster: imposed if any of its pores is
+  std::vector<double> volume;                   // m^3 per cluster
+  std::vector<PoreBoundary> boundary;           // per cluster: imposed if any of its pores is
+  std::vector<std::array<double, 3>> position;  // m, its pores' mean centroid (2D: z 0)
   template <class Archive>
   void visit(Archive& ar) {
     ar("of_pore", of_pore), ar("count", count), ar("edge_a", edge_a), ar("edge_b", edge_b);
     ar("edge_conductance", edge_conductance), ar("volume", volume), ar("boundary", boundary);
+    ar("position", position);
   }
 };
 

@@ -6,11 +6,17 @@
 //   critical one, min over pores of v / (K_f sum C) (equation 6 with the fluid modulus it
 //   needs), with real or virtual (equation 7) pore volumes, until the pores balance;
 // - implicit: the balance of every free pore, sum C (p_j - p_i) = 0, solved at once as a
-//   sparse symmetric positive definite system (Eigen: Cholesky LDL^T, or conjugate
-//   gradients with an incomplete Cholesky preconditioner).
+//   sparse symmetric positive definite system (CHOLMOD's supernodal Cholesky, or Eigen's
+//   conjugate gradients with an incomplete Cholesky preconditioner). A coupled run solves
+//   the same network again and again while the particles move a little: ImplicitSolver keeps
+//   the system's pattern, its ordering and symbolic analysis and the last numeric factor, and
+//   solves a moved network by conjugate gradients preconditioned with that factor, from the
+//   last pressures, where that costs fewer flops than factorising again.
 // A cluster no conducting path links to an imposed pressure keeps the pressure it had.
 
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -33,6 +39,18 @@ struct Pressures {
   double inlet = 1.0, outlet = 0.0;  // Pa
 };
 
+// How an implicit solve was reached.
+enum class ImplicitPath : std::uint8_t {
+  Factorised,    // a new pattern: ordering, symbolic analysis, numeric factor, solve
+  Refactorised,  // the pattern kept: numeric factor and solve
+  Iterated,      // conjugate gradients preconditioned with the kept factor
+  Incomplete,    // conjugate gradients with incomplete Cholesky (ImplicitMethod::ConjugateGradient)
+  Explicit,      // not an implicit solve
+};
+
+// "factorised", "refactorised", ...
+const char* describe(ImplicitPath path);
+
 struct SteadyFlow {
   std::vector<double> pressure;  // Pa, per cluster
   double inflow = 0.0;           // m^3/s into the sample through the inlet clusters
@@ -43,11 +61,18 @@ struct SteadyFlow {
   double seconds = 0.0;      // wall time of the solve
   std::size_t isolated = 0;  // clusters with no conducting path to a boundary
   double dt = 0.0;           // s, the explicit step used (0 for implicit)
+  ImplicitPath path = ImplicitPath::Explicit;
+  // Where an implicit solve's time went (s): the system's values and right-hand side, the
+  // ordering and symbolic analysis, the numeric factor, the triangular solves or iterations.
+  double assembly_seconds = 0.0, analysis_seconds = 0.0;
+  double factorisation_seconds = 0.0, solve_seconds = 0.0;
   template <class Archive>
   void visit(Archive& ar) {
     ar("pressure", pressure), ar("inflow", inflow), ar("outflow", outflow);
     ar("iterations", iterations), ar("residual", residual), ar("converged", converged);
-    ar("seconds", seconds), ar("isolated", isolated), ar("dt", dt);
+    ar("seconds", seconds), ar("isolated", isolated), ar("dt", dt), ar("path", path);
+    ar("assembly_seconds", assembly_seconds), ar("analysis_seconds", analysis_seconds);
+    ar("factorisation_seconds", factorisation_seconds), ar("solve_seconds", solve_seconds);
   }
 };
 
@@ -59,6 +84,7 @@ enum class ImplicitMethod { Cholesky, ConjugateGradient };
 struct ImplicitSettings {
   ImplicitMethod method = ImplicitMethod::Cholesky;
   double tolerance = 1e-12;  // relative residual for conjugate gradients
+  bool reuse_factor = true;  // Cholesky: keep the pattern and factor from call to call
 
   template <class F>
   void fields(F& f) {
@@ -71,10 +97,66 @@ struct ImplicitSettings {
        "sparse LDL^T, or conjugate gradients with incomplete Cholesky"},
       kMethods);
     f(tolerance, {"implicit_tolerance", units::none, Range::leftOpen(0, 1e-2),
-                  "conjugate gradients' relative residual"});
+                  "conjugate gradients' relative residual (also the iterations on a kept "
+                  "Cholesky factor)"});
+    f(reuse_factor, {"implicit_reuse_factor",
+                     units::text,
+                     {},
+                     "Cholesky: keep the ordering and the factor from one update to the next "
+                     "and iterate on them while that is cheaper than factorising (off: "
+                     "factorise anew every update)"});
   }
 };
 
+// The implicit solve of one network, called again and again as its particles move.
+//
+// With the Cholesky method and reuse_factor, it keeps what does not change while the
+// clusters and their pipes stay the same: the matrix's pattern, CHOLMOD's ordering and
+// symbolic analysis, and the numeric factor of the conductances it last factorised. A
+// network with the same pattern is then solved by conjugate gradients preconditioned with
+// that factor, starting from `previous`: when the conductances moved little, the factor of
+// the old system is nearly the inverse of the new one and a few iterations reach the
+// tolerance. The iterations are capped where their flops would exceed a new factor's
+// (CHOLMOD's count of the factorisation against two triangular solves and a product per
+// iteration); past the cap the system is factorised anew, and so are the next few. Every
+// choice counts operations, never wall time, so a run takes the same path, and gives the same
+// bits, on any machine and after a resume.
+class ImplicitSolver {
+ public:
+  ImplicitSolver();
+  ~ImplicitSolver();
+  // A copy starts without the kept factor (it is derived state); so does a moved-from one.
+  ImplicitSolver(const ImplicitSolver&);
+  ImplicitSolver& operator=(const ImplicitSolver&);
+  ImplicitSolver(ImplicitSolver&&) noexcept;
+  ImplicitSolver& operator=(ImplicitSolver&&) noexcept;
+
+  SteadyFlow solve(const Clusters& c, const Pressures& bc, const ImplicitSettings& s,
+                   const std::vector<double>& previous);
+
+  // For checkpoints: the kept factor's ordering, the conductances and held clusters it was
+  // made of, and whether the next solve factorises anew. After reading, restore(clusters of
+  // the last solve) rebuilds the same factor, so a resumed run takes the uninterrupted run's
+  // path, to the same bits.
+  template <class Archive>
+  void visit(Archive& ar) {
+    ar("ordering", ordering_), ar("factored_conductance", factored_conductance_);
+    ar("factored_held", factored_held_), ar("direct_ahead", direct_ahead_);
+    ar("backoff", backoff_);
+  }
+  void restore(const Clusters& last);
+
+ private:
+  struct Kept;
+  std::unique_ptr<Kept> kept_;
+  std::vector<int> ordering_;                 // of the kept pattern's rows
+  std::vector<double> factored_conductance_;  // per cluster pipe, of the kept factor
+  std::vector<char> factored_held_;           // per cluster: its pressure was held
+  std::uint32_t direct_ahead_ = 0;            // solves to factorise before iterating again
+  std::uint32_t backoff_ = 0;                 // the last such run's length
+};
+
+// One solve on a fresh ImplicitSolver.
 SteadyFlow solveImplicit(const Clusters& c, const Pressures& bc, const ImplicitSettings& s,
                          const std::vector<double>& previous);
 

@@ -22,6 +22,8 @@ const Outputs& outputs() {
               {"flow.axial_strain", "-", "axial strain at the solve"},
               {"flow.volumetric_strain", "-", "volumetric strain at the solve"},
               {"flow.solve_seconds", "s", "wall time of the solve"},
+              {"flow.solve_iterations", "-",
+               "conjugate-gradient iterations of the solve (0: a direct solve)"},
               {"flow.triangulations", "-", "triangulations so far"},
           })
           .results({
@@ -48,6 +50,9 @@ const Outputs& outputs() {
               {"k_over_k0_final", "-", "permeability at the end over the initial"},
               {"k_over_k0_final_*", "-", "the same by direction (both measured)"},
               {"triangulations", "-", "triangulations of the run"},
+              {"flow_solves_factorised", "-", "solves on a new pattern: ordered and factorised"},
+              {"flow_solves_refactorised", "-", "solves factorised again on a kept ordering"},
+              {"flow_solves_iterated", "-", "solves by iterations on the kept factor"},
               {"mean_stress_peak_MPa", "MPa", "mean stress at the end of hydrostatic loading"},
               {"porosity_at_peak", "-", "porosity at the end of hydrostatic loading"},
           })

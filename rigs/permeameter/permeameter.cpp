@@ -58,6 +58,19 @@ flow::FlowReading FlowStage<D>::solve(Direction& d, Simulation<D>* apply_to,
   network_seconds_ += d.reading.network_seconds;
   solve_seconds_ += d.reading.solve.seconds;
   ++solves_;
+  switch (d.reading.solve.path) {
+    case flow::ImplicitPath::Factorised:
+      ++factorised_;
+      break;
+    case flow::ImplicitPath::Refactorised:
+      ++refactorised_;
+      break;
+    case flow::ImplicitPath::Iterated:
+      ++iterated_;
+      break;
+    default:
+      break;
+  }
   return d.reading;
 }
 
@@ -164,6 +177,7 @@ void FlowRecorder<D>::state(const FlowStage<D>& flow) {
   rec_.series("flow.axial_strain", step, t, frame.strain(D - 1));
   rec_.series("flow.volumetric_strain", step, t, frame.volumetricStrain());
   rec_.series("flow.solve_seconds", step, t, last.solve.seconds);
+  rec_.series("flow.solve_iterations", step, t, static_cast<double>(last.solve.iterations));
   rec_.series("flow.triangulations", step, t, static_cast<double>(last.triangulations));
 }
 
@@ -216,6 +230,9 @@ void FlowRecorder<D>::final(const FlowStage<D>& flow) {
     rec_.result("k_over_k0_final" + suffix, d.coupling->lastPermeability() / d.k0, "");
   }
   rec_.result("triangulations", static_cast<double>(flow.triangulations()), "");
+  rec_.result("flow_solves_factorised", static_cast<double>(flow.factorised()), "");
+  rec_.result("flow_solves_refactorised", static_cast<double>(flow.refactorised()), "");
+  rec_.result("flow_solves_iterated", static_cast<double>(flow.iterated()), "");
   pressureField(flow, "final");
   rec_.stageTiming("flow", flow.updateSeconds(), flow.updates());
 }

@@ -138,6 +138,11 @@ class FlowStage : public CoupledState {
   double updateSeconds() const { return update_seconds_; }
   std::uint64_t solves() const { return solves_; }
   std::uint64_t updates() const { return updates_; }
+  // Implicit solves by how they were reached (flow::ImplicitPath): new factors, factors of a
+  // kept ordering, iterations on a kept factor.
+  std::uint64_t factorised() const { return factorised_; }
+  std::uint64_t refactorised() const { return refactorised_; }
+  std::uint64_t iterated() const { return iterated_; }
 
   void save(ArchiveWriter& ar) override { visit(ar); }
   void load(ArchiveReader& ar) override { visit(ar); }
@@ -152,7 +157,8 @@ class FlowStage : public CoupledState {
     ar("triangulations", triangulations_), ar("network_seconds", network_seconds_);
     ar("solve_seconds", solve_seconds_), ar("update_seconds", update_seconds_);
     ar("solves", solves_), ar("updates", updates_), ar("updated", updated_);
-    ar("last_step", last_step_);
+    ar("last_step", last_step_), ar("factorised", factorised_);
+    ar("refactorised", refactorised_), ar("iterated", iterated_);
   }
   flow::FlowReading solve(Direction& d, Simulation<D>* apply_to, const Simulation<D>& sim);
   std::vector<Direction> dirs_;
@@ -160,6 +166,7 @@ class FlowStage : public CoupledState {
   std::size_t triangulations_ = 0;
   double network_seconds_ = 0.0, solve_seconds_ = 0.0, update_seconds_ = 0.0;
   std::uint64_t solves_ = 0, updates_ = 0;
+  std::uint64_t factorised_ = 0, refactorised_ = 0, iterated_ = 0;
   bool updated_ = false;
   std::uint64_t last_step_ = 0;
 };
