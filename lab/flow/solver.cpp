@@ -161,36 +161,37 @@ std::vector<char> heldOf(const Clusters& c, const std::vector<char>& live) {
   return held;
 }
 
-// The system over every cluster, so that its pattern depends on the pipes alone: which
-// clusters are imposed (the end layers shift as the sample deforms) or cut off changes
-// values, not the pattern. A free cluster's row is its balance, sum C (p_i - p_j) = 0; a held
-// cluster's row is d_i p_i = d_i p_held, with d_i its pipes' total conductance (so every row
-// has the same scale), and its columns moved to the right-hand side (the matrix stays
-// symmetric). Each pipe's four entries are found once, so new conductances are written in
-// place.
+// The system over every cluster. A free cluster's row is its balance, sum C (p_i - p_j) = 0;
+// a held cluster's row is d_i p_i = d_i p_held, with d_i its pipes' total conductance (so
+// every row has the same scale), and its couplings are moved to the right-hand side, so that
+// the matrix stays symmetric and holds no entry between a held and a free cluster (they would
+// only add fill). The rows keep their clusters' numbers: a factor made with other clusters
+// held still preconditions the system when the end layers shift. Each pipe's entries are
+// found once, so new conductances are written in place.
 struct Pattern {
   std::size_t count = 0;
   std::vector<std::uint32_t> edge_a, edge_b;
-  SparseMatrix matrix;                            // both triangles
-  std::vector<std::array<std::int64_t, 4>> slot;  // of (a,a), (b,b), (a,b), (b,a) in the values
-  std::vector<std::int64_t> diagonal;             // of (i,i)
+  std::vector<char> held;
+  SparseMatrix matrix;  // both triangles
+  // Per pipe, where (a,a), (b,b), (a,b) and (b,a) sit in the values; -1: not in the matrix.
+  std::vector<std::array<std::int64_t, 4>> slot;
+  std::vector<std::int64_t> diagonal;  // of (i,i)
 
-  bool matches(const Clusters& c) const {
+  bool samePipes(const Clusters& c) const {
     return count == c.count && edge_a == c.edge_a && edge_b == c.edge_b;
   }
 
-  void fill(const std::vector<double>& conductance, const std::vector<char>& held) {
+  void fill(const std::vector<double>& conductance) {
     double* v = matrix.valuePtr();
     std::fill(v, v + matrix.nonZeros(), 0.0);
     std::vector<double> total(count, 0.0);
     for (std::size_t k = 0; k < slot.size(); ++k) {
       const double g = conductance[k];
-      const auto a = edge_a[k], b = edge_b[k];
       const auto& s = slot[k];
-      total[a] += g, total[b] += g;
-      if (!held[a]) v[s[0]] += g;
-      if (!held[b]) v[s[1]] += g;
-      if (!held[a] && !held[b]) v[s[2]] -= g, v[s[3]] -= g;
+      total[edge_a[k]] += g, total[edge_b[k]] += g;
+      if (s[0] >= 0) v[s[0]] += g;
+      if (s[1] >= 0) v[s[1]] += g;
+      if (s[2] >= 0) v[s[2]] -= g, v[s[3]] -= g;
     }
     double mean = 0.0;
     for (double t : total) mean += t;
@@ -201,8 +202,7 @@ struct Pattern {
   }
 
   // What the held pressures push into their free neighbours, and their own rows.
-  Eigen::VectorXd rhs(const std::vector<double>& conductance, const std::vector<char>& held,
-                      const std::vector<double>& p) const {
+  Eigen::VectorXd rhs(const std::vector<double>& conductance, const std::vector<double>& p) const {
     Eigen::VectorXd b = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(count));
     const double* v = matrix.valuePtr();
     for (std::size_t k = 0; k < slot.size(); ++k) {
@@ -217,21 +217,25 @@ struct Pattern {
   }
 };
 
-Pattern patternOf(const Clusters& c) {
+Pattern patternOf(const Clusters& c, const std::vector<char>& held) {
   Pattern p;
   p.count = c.count;
-  p.edge_a = c.edge_a, p.edge_b = c.edge_b;
-  // Each column: the diagonal and the cluster's neighbours, sorted, parallel pipes once.
+  p.edge_a = c.edge_a, p.edge_b = c.edge_b, p.held = held;
+  auto coupled = [&](std::size_t k) { return !held[c.edge_a[k]] && !held[c.edge_b[k]]; };
+  // Each column: the diagonal and the free cluster's free neighbours, sorted, parallel pipes
+  // once.
   const auto n = static_cast<Eigen::Index>(c.count);
   std::vector<int> start(c.count + 1, 0);
   for (std::size_t i = 0; i < c.count; ++i) start[i + 1] = 1;
-  for (std::size_t k = 0; k < c.edge_a.size(); ++k)
-    ++start[c.edge_a[k] + 1], ++start[c.edge_b[k] + 1];
+  for (std::size_t k = 0; k < c.edge_a.size(); ++k) {
+    if (coupled(k)) ++start[c.edge_a[k] + 1], ++start[c.edge_b[k] + 1];
+  }
   for (std::size_t i = 0; i < c.count; ++i) start[i + 1] += start[i];
   std::vector<int> rows(static_cast<std::size_t>(start.back())),
       fill(start.begin(), start.end() - 1);
   for (std::size_t i = 0; i < c.count; ++i) rows[fill[i]++] = static_cast<int>(i);
   for (std::size_t k = 0; k < c.edge_a.size(); ++k) {
+    if (!coupled(k)) continue;
     const auto a = c.edge_a[k], b = c.edge_b[k];
     rows[fill[a]++] = static_cast<int>(b), rows[fill[b]++] = static_cast<int>(a);
   }
@@ -259,7 +263,9 @@ Pattern patternOf(const Clusters& c) {
   p.slot.resize(c.edge_a.size());
   for (std::size_t k = 0; k < c.edge_a.size(); ++k) {
     const auto a = c.edge_a[k], b = c.edge_b[k];
-    p.slot[k] = {p.diagonal[a], p.diagonal[b], at(a, b), at(b, a)};
+    const bool both = coupled(k);
+    p.slot[k] = {held[a] ? -1 : p.diagonal[a], held[b] ? -1 : p.diagonal[b], both ? at(a, b) : -1,
+                 both ? at(b, a) : -1};
   }
   return p;
 }
@@ -271,10 +277,10 @@ Pattern patternOf(const Clusters& c) {
 // those with the most cut pipes first), and that separator is ordered after the two sides,
 // each ordered the same way down to a few clusters. Of the axes tried, the smallest separator
 // wins. Measured on the 115,882 pores of the 20,000-sphere benchmark packing
-// (`rocklab bench --flow`, one thread): this ordering takes 0.08 s and gives a factor of
-// 1.5e10 flops (1.25 s); METIS's nested dissection gives 1.1e10 flops but takes 0.6-0.8 s,
-// and so does CHOLMOD's default (AMD, then METIS); AMD alone takes 0.12 s and gives a
-// factor of 2.4 s.
+// (`rocklab bench --flow`, one thread), with the imposed clusters still coupled in the
+// pattern: this ordering took 0.08 s and gave a factor of 1.5e10 flops (1.25 s); METIS's
+// nested dissection gave 1.1e10 flops but took 0.6-0.8 s, and so did CHOLMOD's default (AMD,
+// then METIS); AMD alone took 0.12 s and gave a factor of 2.4 s.
 class GeometricDissection {
  public:
   GeometricDissection(const SparseMatrix& A, const std::vector<std::array<double, 3>>& position)
@@ -451,9 +457,10 @@ class SupernodalFactor {
 
 // Per flop, CHOLMOD's supernodal factorisation (dense updates) runs several times faster than
 // an iteration's memory-bound triangular solves and product. Measured on the 20,000-sphere
-// benchmark packing (`rocklab bench --flow`, one thread): the factor's 1.5e10 flops take
-// 1.25-1.35 s (about 12 Gflop/s), an iteration's 4 lnz + 2 nnz(A) = 7.4e7 flops take
-// 0.034 s (2.2 Gflop/s). The cap on the iterations counts each of their flops at this weight.
+// benchmark packing (`rocklab bench --flow`, one thread): the factor's 1.2e10 flops take
+// 1.1-1.2 s (about 10 Gflop/s), an iteration's 4 lnz + 2 nnz(A) = 6.5e7 flops take
+// 0.03-0.04 s (about 2 Gflop/s). The cap on the iterations counts each of their flops at this
+// weight.
 constexpr double kIterationFlopWeight = 5.0;
 
 // The most direct solves in a row before the iterations on a kept factor are tried again.
@@ -540,8 +547,8 @@ void ImplicitSolver::restore(const Clusters& last) {
     return;
   }
   kept_ = std::make_unique<Kept>();
-  kept_->pattern = patternOf(last);
-  kept_->pattern.fill(factored_conductance_, factored_held_);
+  kept_->pattern = patternOf(last, factored_held_);
+  kept_->pattern.fill(factored_conductance_);
   kept_->factor.analyse(kept_->pattern.matrix, ordering_);
   kept_->factor.factorise(kept_->pattern.matrix);
 }
@@ -555,16 +562,18 @@ SteadyFlow ImplicitSolver::solve(const Clusters& c, const Pressures& bc, const I
   const auto held = heldOf(c, live);
   for (std::size_t i = 0; i < c.count; ++i) out.isolated += live[i] ? 0 : 1;
   const bool keep = s.method == ImplicitMethod::Cholesky && s.reuse_factor;
-  if (!keep || !kept_ || !kept_->pattern.matches(c)) {
+  if (!keep || !kept_ || !kept_->pattern.samePipes(c)) {
     kept_ = std::make_unique<Kept>();
-    kept_->pattern = patternOf(c);
+    kept_->pattern = patternOf(c, held);
     factored_conductance_.clear(), factored_held_.clear(), ordering_.clear();
     direct_ahead_ = backoff_ = 0;
     out.path = ImplicitPath::Factorised;
+  } else if (kept_->pattern.held != held) {
+    kept_->pattern = patternOf(c, held);  // the kept factor still preconditions it
   }
   Pattern& pattern = kept_->pattern;
-  pattern.fill(c.edge_conductance, held);
-  const Eigen::VectorXd rhs = pattern.rhs(c.edge_conductance, held, out.pressure);
+  pattern.fill(c.edge_conductance);
+  const Eigen::VectorXd rhs = pattern.rhs(c.edge_conductance, out.pressure);
   Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(out.pressure.data(), rhs.size());
   const double goal = residualGoal(rhs, held, s.tolerance);
   const auto t1 = std::chrono::steady_clock::now();
@@ -586,16 +595,9 @@ SteadyFlow ImplicitSolver::solve(const Clusters& c, const Pressures& bc, const I
     out.path = ImplicitPath::Incomplete;
   } else {
     bool solved = false;
-    if (out.path == ImplicitPath::Factorised) {
-      if (c.position.size() != c.count) {
-        throw std::logic_error("flow: clusters without positions cannot be ordered");
-      }
-      ordering_ = GeometricDissection(pattern.matrix, c.position).order();
-      kept_->factor.analyse(pattern.matrix, ordering_);
-      out.analysis_seconds = secondsSince(t1);
-    } else if (direct_ahead_ > 0) {
+    if (out.path != ImplicitPath::Factorised && direct_ahead_ > 0) {
       --direct_ahead_;
-    } else {
+    } else if (out.path != ImplicitPath::Factorised) {
       const auto t2 = std::chrono::steady_clock::now();
       const Iterated it =
           preconditionedCg(pattern.matrix, kept_->factor, rhs, x, goal, kept_->iterationCap());
@@ -612,14 +614,26 @@ SteadyFlow ImplicitSolver::solve(const Clusters& c, const Pressures& bc, const I
       direct_ahead_ = backoff_;
     }
     if (!solved) {
-      if (out.path != ImplicitPath::Factorised) out.path = ImplicitPath::Refactorised;
+      // The kept analysis serves while the same clusters are held as when it was made.
       const auto t2 = std::chrono::steady_clock::now();
+      if (out.path == ImplicitPath::Factorised || factored_held_ != held) {
+        if (c.position.size() != c.count) {
+          throw std::logic_error("flow: clusters without positions cannot be ordered");
+        }
+        ordering_ = GeometricDissection(pattern.matrix, c.position).order();
+        kept_->factor.analyse(pattern.matrix, ordering_);
+        out.path = ImplicitPath::Factorised;
+      } else {
+        out.path = ImplicitPath::Refactorised;
+      }
+      const auto t3 = std::chrono::steady_clock::now();
+      out.analysis_seconds = std::chrono::duration<double>(t3 - t2).count();
       kept_->factor.factorise(pattern.matrix);
       if (keep) factored_conductance_ = c.edge_conductance, factored_held_ = held;
-      const auto t3 = std::chrono::steady_clock::now();
-      out.factorisation_seconds = std::chrono::duration<double>(t3 - t2).count();
+      const auto t4 = std::chrono::steady_clock::now();
+      out.factorisation_seconds = std::chrono::duration<double>(t4 - t3).count();
       x = kept_->factor.solve(rhs);
-      out.solve_seconds += secondsSince(t3);
+      out.solve_seconds += secondsSince(t4);
     }
     out.converged = true;
   }

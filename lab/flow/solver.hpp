@@ -111,16 +111,17 @@ struct ImplicitSettings {
 // The implicit solve of one network, called again and again as its particles move.
 //
 // With the Cholesky method and reuse_factor, it keeps what does not change while the
-// clusters and their pipes stay the same: the matrix's pattern, CHOLMOD's ordering and
+// clusters and their pipes stay the same: the matrix's pattern, the ordering and CHOLMOD's
 // symbolic analysis, and the numeric factor of the conductances it last factorised. A
-// network with the same pattern is then solved by conjugate gradients preconditioned with
-// that factor, starting from `previous`: when the conductances moved little, the factor of
-// the old system is nearly the inverse of the new one and a few iterations reach the
-// tolerance. The iterations are capped where their flops would exceed a new factor's
-// (CHOLMOD's count of the factorisation against two triangular solves and a product per
-// iteration); past the cap the system is factorised anew, and so are the next few. Every
-// choice counts operations, never wall time, so a run takes the same path, and gives the same
-// bits, on any machine and after a resume.
+// network with the same pipes is then solved by conjugate gradients preconditioned with that
+// factor, starting from `previous` (also when other clusters are held now: the rows keep
+// their clusters' numbers): when the conductances moved little, the factor of the old
+// system is nearly the inverse of the new one and a few iterations reach the tolerance. The
+// iterations are capped where their flops would exceed a new factor's (CHOLMOD's count of
+// the factorisation against two triangular solves and a product per iteration); past the
+// cap the system is factorised anew (ordered and analysed anew if other clusters are held),
+// and so are the next few. Every choice counts operations, never wall time, so a run takes
+// the same path, and gives the same bits, on any machine and after a resume.
 class ImplicitSolver {
  public:
   ImplicitSolver();
