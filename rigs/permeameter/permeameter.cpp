@@ -203,7 +203,13 @@ void FlowRecorder<D>::pressureField(const FlowStage<D>& flow, const std::string&
 template <int D>
 void FlowRecorder<D>::compareSolvers(const FlowStage<D>& flow) {
   const auto& sim = *sp_.sim;
-  for (const auto& c : flow.primary().coupling->compareSolvers()) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto costs = flow.primary().coupling->compareSolvers();
+  // Its own stage timing: the explicit schemes can take most of a run (the real-volume one
+  // runs to flow.explicit_max_steps where the network has flat pores).
+  rec_.stageTiming("flow_solver_comparison",
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1);
+  for (const auto& c : costs) {
     if (!c.refused.empty()) {
       rec_.message(sim.steps(), sim.time(), "info", "solver " + c.name + " not run: " + c.refused);
       continue;
