@@ -107,7 +107,8 @@ class FlowCoupling {
     std::size_t iterations = 0;
     double max_difference = 0.0;
     bool converged = false;
-    std::string refused;  // why a solver could not run (the explicit step), or empty
+    double predicted_iterations = 0.0;  // explicit, given up: the steps it needs at least
+    std::string refused;                // why a solver could not run (the explicit step), or empty
   };
   std::vector<SolverCost> compareSolvers() const;
 

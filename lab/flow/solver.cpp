@@ -685,6 +685,11 @@ SteadyFlow solveExplicit(const Clusters& c, const Pressures& bc, const ExplicitS
   const double drop = referenceDrop(bc);
   std::vector<double> taken(c.count);
   auto& p = out.pressure;
+  // The decay of the largest imbalance over windows of a hundredth of the budget. A
+  // Jacobi-like scheme's decay only slows as its faster modes die out, so the steps the last
+  // window's rate predicts are a lower bound: past the budget, the scheme cannot make it.
+  const std::size_t window = std::max<std::size_t>(1000, s.max_steps / 100);
+  double window_worst = 0.0;
   for (out.iterations = 0; out.iterations < s.max_steps; ++out.iterations) {
     std::fill(taken.begin(), taken.end(), 0.0);
     for (std::size_t k = 0; k < c.edge_a.size(); ++k) {
@@ -705,6 +710,20 @@ SteadyFlow solveExplicit(const Clusters& c, const Pressures& bc, const ExplicitS
     if (worst < s.tolerance) {
       out.converged = true;
       break;
+    }
+    if (s.give_up_when_hopeless && (out.iterations + 1) % window == 0) {
+      if (window_worst > 0.0) {
+        const double rate = std::log(worst / window_worst) / static_cast<double>(window);
+        const double needed = rate < 0.0 ? static_cast<double>(out.iterations + 1) +
+                                               std::log(s.tolerance / worst) / rate
+                                         : std::numeric_limits<double>::infinity();
+        if (needed > static_cast<double>(s.max_steps)) {
+          out.predicted_iterations = needed;
+          ++out.iterations;
+          break;
+        }
+      }
+      window_worst = worst;
     }
   }
   balance(c, bc, live, out);

@@ -47,6 +47,9 @@ const Outputs& outputs() {
               {"solver_*_iterations", "-", "its iterations"},
               {"solver_*_max_difference", "-", "its largest difference from Cholesky's"},
               {"solver_*_converged", "-", "1: it converged"},
+              {"solver_*_predicted_iterations", "-",
+               "an explicit scheme given up before flow.explicit_max_steps: the steps its "
+               "rate so far needs at least"},
               {"k_over_k0_final", "-", "permeability at the end over the initial"},
               {"k_over_k0_final_*", "-", "the same by direction (both measured)"},
               {"triangulations", "-", "triangulations of the run"},

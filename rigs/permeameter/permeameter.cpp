@@ -218,10 +218,18 @@ void FlowRecorder<D>::compareSolvers(const FlowStage<D>& flow) {
     rec_.result("solver_" + c.name + "_iterations", static_cast<double>(c.iterations), "");
     rec_.result("solver_" + c.name + "_max_difference", c.max_difference, "");
     rec_.result("solver_" + c.name + "_converged", c.converged ? 1.0 : 0.0, "");
+    if (c.predicted_iterations > 0.0) {
+      rec_.result("solver_" + c.name + "_predicted_iterations", c.predicted_iterations, "");
+    }
     if (!c.converged) {
+      const std::string rate =
+          c.predicted_iterations > 0.0
+              ? ": given up, its rate so far needs at least " + fmt(c.predicted_iterations)
+              : "";
       rec_.message(sim.steps(), sim.time(), "warning",
                    "solver " + c.name + " did not converge in " + fmt(double(c.iterations)) +
-                       " iterations (flow.explicit_max_steps, flow.explicit_tolerance)");
+                       " iterations" + rate +
+                       " (flow.explicit_max_steps, flow.explicit_tolerance)");
     }
   }
 }
