@@ -218,6 +218,8 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
     cement.stiffness_ratio = 1.0;
     cement.tensile_mean = cement.shear_mean = kBondStrength;
     cement.tensile_std = cement.shear_std = 0.0;
+    if (options.bond_model == "flat_joint") cement.model = BondModel::FlatJoint;
+    r.flat_joints = cement.model == BondModel::FlatJoint;
     r.bonds = sim.cement(sim.addBondKind(cement), 0.0).installed;
     r.bond_lanes = cfg.bond_lanes && bondLanesAvailable();
   }
@@ -355,6 +357,7 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
           << ", \"wall_stress_end_Pa\": " << r.wall_stress_end << ", \"rebuilds\": " << r.rebuilds
           << ", \"listed_pairs\": " << r.listed_pairs << ", \"bonds\": " << r.bonds
           << ", \"bond_lanes\": " << (r.bond_lanes ? "true" : "false")
+          << ", \"flat_joints\": " << (r.flat_joints ? "true" : "false")
           << ", \"peak_rss_bytes\": " << r.peak_rss_bytes << ", \"state_hash\": \"" << std::hex
           << r.state_hash << std::dec << "\"}" << (k + 1 < results.size() ? "," : "") << "\n";
     }
@@ -392,9 +395,10 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
   }
   if (!results.empty()) {
     out << "rocklab bench: " << source << ", Hertz-Mindlin"
-        << (results.front().bonds == 0   ? ""
-            : results.front().bond_lanes ? " + parallel bonds (four per AVX register)"
-                                         : " + parallel bonds (one at a time)")
+        << (results.front().bonds == 0    ? ""
+            : results.front().flat_joints ? " + flat joints (2 rings of 3 elements)"
+            : results.front().bond_lanes  ? " + parallel bonds (four per AVX register)"
+                                          : " + parallel bonds (one at a time)")
         << ", dt = " << kTimeStep << " s\n";
     out << std::left << std::setw(8) << "threads" << std::setw(10) << "N" << std::setw(8) << "steps"
         << std::setw(11) << "seconds" << std::setw(20) << "particle-steps/s" << std::setw(9)

@@ -25,11 +25,13 @@ struct BenchOptions {
   std::string save_packing;          // write the generated packing here
   std::array<int, 3> tile{1, 1, 1};  // copies of the packing along x, y, z (a larger scene)
   bool scalar_bonds = false;         // bonds one at a time, not four per AVX register (same bits)
-  bool bonded = false;               // a parallel bond on every initial contact (cemented rock)
+  bool bonded = false;               // a bond on every initial contact (cemented rock)
   bool flow = false;                 // also time the pore network and a steady solve on the packing
   double flow_strain = 1e-4;         // axial strain of the packing before the repeat flow call
   bool render = false;               // also time an off-screen snapshot of the packing
   std::string render_dir = ".";      // where the snapshot's PNGs go
+  // The bonds' model when bonded: "parallel" or "flat_joint".
+  std::string bond_model = "parallel";
 };
 
 struct BenchResult {
@@ -46,6 +48,7 @@ struct BenchResult {
   std::uint64_t listed_pairs = 0;  // pairs in the neighbour list at the end
   std::uint64_t bonds = 0;         // bonded variant: bonds installed (none break: see bench.cpp)
   bool bond_lanes = false;         // the bonds ran four per AVX register (else one at a time)
+  bool flat_joints = false;        // the bonds were flat joints (one at a time, beside the lanes)
   std::uint64_t state_hash = 0;
   double peak_rss_bytes = 0.0;  // of the process so far (getrusage)
 };

@@ -196,7 +196,12 @@ void addBench(CLI::App& app, Action& action) {
   b->add_option("--tile", o->tile, "Copies of the packing along x,y,z, e.g. 5,5,4")
       ->delimiter(',')
       ->check(CLI::Range(1, 1000));
-  b->add_flag("--bonded", o->bonded, "A parallel bond on every initial contact");
+  CLI::Option* bonded = b->add_flag(
+      "--bonded", o->bonded, "A bond (parallel unless --bond-model) on every initial contact");
+  b->add_option("--bond-model", o->bond_model,
+                "The bonds' model: parallel, or flat_joint (2 rings of 3 elements, as PFC's)")
+      ->check(CLI::IsMember({"parallel", "flat_joint"}))
+      ->needs(bonded);
   b->add_flag("--scalar-bonds", o->scalar_bonds,
               "Bonds one at a time instead of four per AVX register (the same bits, slower)");
   b->add_flag("--flow", o->flow,

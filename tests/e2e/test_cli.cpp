@@ -116,6 +116,22 @@ TEST(Cli, BenchVariantsTileBondFlowAndRender) {
   ASSERT_EQ(hashes.size(), 3u);
   EXPECT_EQ(hashes[0], hashes[1]);
   EXPECT_EQ(hashes[0], hashes[2]);
+  // Flat joints on the same contacts, one at a time beside the lanes: the same state on
+  // one and two threads; a model without --bonded is refused.
+  const auto joints = run("bench --packing " + packing +
+                          " --bonded --bond-model flat_joint --threads 1,2 --steps 20 --warmup 5 "
+                          "--json");
+  ASSERT_EQ(joints.status, 0) << joints.out;
+  EXPECT_NE(joints.out.find("\"flat_joints\": true"), std::string::npos) << joints.out;
+  EXPECT_EQ(number(joints.out, "bonds"), number(bonded.out, "bonds"));
+  std::vector<std::string> joint_hashes;
+  for (auto it = std::sregex_iterator(joints.out.begin(), joints.out.end(), hash);
+       it != std::sregex_iterator(); ++it) {
+    joint_hashes.push_back((*it)[1]);
+  }
+  ASSERT_EQ(joint_hashes.size(), 2u);
+  EXPECT_EQ(joint_hashes[0], joint_hashes[1]);
+  EXPECT_NE(run("bench --packing " + packing + " --bond-model flat_joint --steps 1").status, 0);
 
   const auto flow = run("bench --packing " + packing + " --flow --json");
   ASSERT_EQ(flow.status, 0) << flow.out;
@@ -295,7 +311,9 @@ TEST(Cli, ShippedProtocolsCheck) {
     if (stem.ends_with("-quick")) {
       EXPECT_TRUE(fs::exists(source / "tests/reference" / (stem + ".toml"))) << stem;
       const fs::path full = source / "protocols" / (stem.substr(0, stem.size() - 6) + ".toml");
-      if (fs::exists(full)) EXPECT_EQ(field(full, "rig"), field(f.path(), "rig")) << full;
+      if (fs::exists(full)) {
+        EXPECT_EQ(field(full, "rig"), field(f.path(), "rig")) << full;
+      }
     }
     ++checked;
   }
