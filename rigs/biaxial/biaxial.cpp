@@ -297,7 +297,9 @@ void findBands(const Specimen<D>& sp, const BandAnalysis& analysis, const Loadin
     return band;
   };
   const std::size_t last = states.size() - 1;
-  consider(from, last);
+  if (const auto range = consider(from, last)) {
+    rec.result(n.prefix + "band_range_contrast", range->contrast, "");
+  }
   if (compactive) {
     // Each window's band, at the window's end: how the band moves and turns as the
     // compaction proceeds.

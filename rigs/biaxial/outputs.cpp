@@ -56,6 +56,9 @@ const Outputs& outputs() {
               {"band_thickness_mm", "mm", "thickness of the band"},
               {"band_contrast", "-", "the band's count over a uniform cloud's"},
               {"band_points", "-", "points the band was sought in"},
+              {"band_range_contrast", "-",
+               "contrast of the band over the whole post-critical range (a compactive test's "
+               "windows each have theirs)"},
               {"break_band_angle_deg", "deg", "the band of the bond breaks, to sigma_1"},
               {"break_band_is_compaction", "-", "1: within 20 deg of normal to sigma_1"},
               {"break_band_thickness_mm", "mm", "thickness of the break band"},

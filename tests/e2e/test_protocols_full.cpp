@@ -50,12 +50,18 @@ TEST(QuickProtocols, HighConfinementBreaksInShearAndCrushesGrains) {
   EXPECT_EQ(result(high, "band_in_compaction_field"), 1.0);
   EXPECT_EQ(result(high, "band_is_compaction"), 1.0);  // within 20 deg of normal to sigma_1
   EXPECT_GT(result(high, "band_contrast"), 3.0);       // a band, not diffuse compaction
-  // The band of each twentieth of the strain range after the critical point is recorded;
-  // the band kept is the most contrasted of them and of the whole range's.
+  // The band of each twentieth of the strain range after the critical point is recorded. A
+  // compaction band migrates along the sample (Olsson 1999; Baud et al. 2004): sharp in its
+  // own strain window, smeared over the whole range. So the windows' bands are on average
+  // more contrasted than the whole range's (measured: a mean of 3.13 over 11 windows, 10 of
+  // them above the range's 2.64); a band that stayed in place would gather its strain in
+  // one zone over the whole range and be sharpest there.
   const std::vector<double> window_contrast = seriesValues(high, "band_window_contrast");
-  EXPECT_GE(window_contrast.size(), 5u);
+  ASSERT_GE(window_contrast.size(), 5u);
   EXPECT_EQ(seriesValues(high, "band_window_angle_deg").size(), window_contrast.size());
-  for (double c : window_contrast) EXPECT_LE(c, result(high, "band_contrast"));
+  double window_mean = 0.0;
+  for (double c : window_contrast) window_mean += c / static_cast<double>(window_contrast.size());
+  EXPECT_GT(window_mean, result(high, "band_range_contrast"));
   // Every break is an event with its kind: intragranular breaks are the crushing.
   EXPECT_EQ(std::stod(scalar(high,
                              "SELECT count(*) FROM events WHERE granular = 'intra' AND "
