@@ -63,8 +63,14 @@ void FaceState<D>::swapSides(const FaceLayout& layout) {
   std::vector<FaceElement<D>> out(elements.size());
   for (std::size_t e = 0; e < elements.size(); ++e) {
     out[e] = elements[layout.mirror(e)];
-    out[e].fs = -out[e].fs;
-    out[e].moment = -out[e].moment;
+    // On the other particle every force and moment is opposite: in its frame a component
+    // along an axis that turns over keeps its sign, and the twist about n too.
+    if (layout.dimension == 3) {
+      out[e].fs[0] = -out[e].fs[0];
+      out[e].bend[0] = -out[e].bend[0];
+    } else {
+      out[e].bend[0] = -out[e].bend[0];
+    }
   }
   elements.swap(out);
 }

@@ -314,8 +314,9 @@ class Simulation {
   // Version 3 added config.bond_breakage, 4 the bond kinds' friction_angle and moment_factor,
   // 5 config.skin_ratio, 6 the applied forces, 7 density scaling (the particles' physical
   // masses, config.timestep.density_scaling, ledger.mass_scaling), 8 flat joints (the bond
-  // kinds' model and faces, the bonds' face states), 9 the flat joints' slit fraction.
-  static constexpr std::uint32_t kCheckpointVersion = 9;
+  // kinds' model and faces, the bonds' face states), 9 the flat joints' slit fraction, 10 the
+  // flat joints' element forces and moments in the face's frame.
+  static constexpr std::uint32_t kCheckpointVersion = 10;
 
  private:
   enum Stage { kIntegrate, kNeighbors, kBodyForces, kContacts, kBonds, kServo, kGuard, kStages };

@@ -235,8 +235,7 @@ EnergyReport Simulation<D>::energy() const {
     FaceMaterial m;
     m.radius = bonds_.radius[b], m.thickness = P.thickness;
     m.kn = bonds_.kn[b], m.ks = bonds_.ks[b];
-    const V n = (P.pos[bonds_.j[b]] - P.pos[bonds_.i[b]]).normalized();
-    e.strain += faceEnergy<D>(layouts[bonds_.kind[b]], m, n, bonds_.face[b]);
+    e.strain += faceEnergy<D>(layouts[bonds_.kind[b]], m, bonds_.face[b]);
   }
   return e;
 }

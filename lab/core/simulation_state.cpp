@@ -98,7 +98,7 @@ std::uint64_t Simulation<D>::stateHash() const {
     for (const FaceElement<D>& e : f.elements) {
       h = fnv1a(&e.bonded, sizeof e.bonded, h);
       h = fnv1a(&e.approach, sizeof e.approach, h);
-      h = fnv1a(e.fs.data(), sizeof(double) * D, h);
+      h = fnv1a(e.fs.data(), sizeof(double) * 2, h);
     }
   }
   for (const auto& w : walls_) {
