@@ -190,15 +190,26 @@ TEST(FlowSolvers, SteadyPressureIsLinearAndSolversAgree2D) {
   steadyFlowIsLinearAndTheSolversAgree<2>({16, 28});
 }
 
-TEST(FlowSolvers, ExplicitSchemeIsStableAtItsCriticalStepAndRefusesALargerOne) {
-  const auto p = latticePack<3>({4, 4, 7}, 0.36, 0.05, 5);
+// A lattice pack's pore network with its ends one layer deep and its flat cells joined to
+// their best neighbour (they would make the explicit scheme's step vanish), and the real
+// volumes' explicit scheme on it: the setting whose step is bounded.
+Clusters mergedLattice(const std::array<int, 3>& cells, double top, std::uint64_t seed) {
+  const auto p = latticePack<3>(cells, 0.36, 0.05, seed);
   const Network<3> net = networkOf<3>(p);
-  // Flat cells would make the step vanish: small pores join their best neighbour.
-  const Clusters c = mergePores<3>(net, endLayers<3>(net, 1.0, 4.0), {0.0, 0.05});
-  const Pressures bc{1.0e4, 0.0};
+  return mergePores<3>(net, endLayers<3>(net, 1.0, top), {0.0, 0.05});
+}
+
+ExplicitSettings realVolumes() {
   ExplicitSettings ex;
+  ex.virtual_volume = false;
+  return ex;
+}
+
+TEST(FlowSolvers, ExplicitSchemeIsStableAtItsCriticalStepAndRefusesALargerOne) {
+  const Clusters c = mergedLattice({4, 4, 7}, 4.0, 5);
+  const Pressures bc{1.0e4, 0.0};
+  ExplicitSettings ex = realVolumes();
   ex.fluid_modulus = 2.2e9;
-  ex.virtual_volume = false;  // the real volumes, whose step is bounded
   ex.tolerance = 1e-8;
   const double critical = criticalFlowStep(c, ex.fluid_modulus);
   ASSERT_GT(critical, 0.0);
@@ -225,12 +236,9 @@ TEST(FlowSolvers, ExplicitSchemeIsStableAtItsCriticalStepAndRefusesALargerOne) {
 // against 72,000), above the budget. A scheme that can converge within its budget is never
 // stopped, to the same bits.
 TEST(FlowSolvers, AHopelessExplicitSchemeGivesUpEarlyAndSaysWhatItWouldNeed) {
-  const auto p = latticePack<3>({5, 5, 12}, 0.36, 0.05, 9);
-  const Network<3> net = networkOf<3>(p);
-  const Clusters c = mergePores<3>(net, endLayers<3>(net, 1.0, 9.0), {0.0, 0.05});
+  const Clusters c = mergedLattice({5, 5, 12}, 9.0, 9);
   const Pressures bc{1.0e4, 0.0};
-  ExplicitSettings ex;
-  ex.virtual_volume = false;
+  ExplicitSettings ex = realVolumes();
   ex.tolerance = 1e-10;
   ex.max_steps = 10000000;
   const SteadyFlow full = solveExplicit(c, bc, ex, {});
