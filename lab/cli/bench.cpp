@@ -203,7 +203,7 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
   cfg.timestep.fixed_dt = kTimeStep;
   cfg.threads = threads;
   cfg.track_energy = options.energy;
-  cfg.bond_lanes = !options.scalar_bonds;
+  cfg.bond_lane_width = options.scalar_bonds ? 0 : 8;
   Simulation<3> sim = makeScene(packing, kFriction, cfg);
   BenchResult r;
   if (options.bonded) {
@@ -221,7 +221,7 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
     if (options.bond_model == "flat_joint") cement.model = BondModel::FlatJoint;
     r.flat_joints = cement.model == BondModel::FlatJoint;
     r.bonds = sim.cement(sim.addBondKind(cement), 0.0).installed;
-    r.bond_lanes = cfg.bond_lanes && bondLanesAvailable();
+    r.bond_lane_width = bondLaneWidth(cfg.bond_lane_width);
   }
   const Eigen::Vector3d extent = boxExtent(sim);
   for (int w = 0; w < 6; ++w) {
@@ -356,7 +356,7 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
           << ", \"wall_stress_start_Pa\": " << r.wall_stress_start
           << ", \"wall_stress_end_Pa\": " << r.wall_stress_end << ", \"rebuilds\": " << r.rebuilds
           << ", \"listed_pairs\": " << r.listed_pairs << ", \"bonds\": " << r.bonds
-          << ", \"bond_lanes\": " << (r.bond_lanes ? "true" : "false")
+          << ", \"bond_lane_width\": " << r.bond_lane_width
           << ", \"flat_joints\": " << (r.flat_joints ? "true" : "false")
           << ", \"peak_rss_bytes\": " << r.peak_rss_bytes << ", \"state_hash\": \"" << std::hex
           << r.state_hash << std::dec << "\"}" << (k + 1 < results.size() ? "," : "") << "\n";
@@ -397,8 +397,10 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
     out << "rocklab bench: " << source << ", Hertz-Mindlin"
         << (results.front().bonds == 0    ? ""
             : results.front().flat_joints ? " + flat joints (2 rings of 3 elements)"
-            : results.front().bond_lanes  ? " + parallel bonds (four per AVX register)"
-                                          : " + parallel bonds (one at a time)")
+            : results.front().bond_lane_width > 0
+                ? " + parallel bonds (" + std::to_string(results.front().bond_lane_width) +
+                      " per vector register)"
+                : std::string(" + parallel bonds (one at a time)"))
         << ", dt = " << kTimeStep << " s\n";
     out << std::left << std::setw(8) << "threads" << std::setw(10) << "N" << std::setw(8) << "steps"
         << std::setw(11) << "seconds" << std::setw(20) << "particle-steps/s" << std::setw(9)

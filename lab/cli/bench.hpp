@@ -47,7 +47,7 @@ struct BenchResult {
   std::uint64_t rebuilds = 0;      // neighbour list rebuilds in the timed phase
   std::uint64_t listed_pairs = 0;  // pairs in the neighbour list at the end
   std::uint64_t bonds = 0;         // bonded variant: bonds installed (none break: see bench.cpp)
-  bool bond_lanes = false;         // the bonds ran four per AVX register (else one at a time)
+  int bond_lane_width = 0;         // the bonds ran this many per vector register (0: one at a time)
   bool flat_joints = false;        // the bonds were flat joints (one at a time, beside the lanes)
   std::uint64_t state_hash = 0;
   double peak_rss_bytes = 0.0;  // of the process so far (getrusage)

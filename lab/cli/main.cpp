@@ -202,8 +202,9 @@ void addBench(CLI::App& app, Action& action) {
                 "The bonds' model: parallel, or flat_joint (2 rings of 3 elements, as PFC's)")
       ->check(CLI::IsMember({"parallel", "flat_joint"}))
       ->needs(bonded);
-  b->add_flag("--scalar-bonds", o->scalar_bonds,
-              "Bonds one at a time instead of four per AVX register (the same bits, slower)");
+  b->add_flag(
+      "--scalar-bonds", o->scalar_bonds,
+      "Bonds one at a time instead of eight or four per vector register (the same bits, slower)");
   b->add_flag("--flow", o->flow,
               "Time the pore network (triangulation, network, steady solve) instead");
   b->add_option("--flow-strain", o->flow_strain,

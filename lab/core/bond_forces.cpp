@@ -55,8 +55,10 @@ void BondStore<D>::removeFlagged(const std::vector<std::uint8_t>& broken) {
   face.resize(out);
 }
 
-bool bondLanesAvailable() {
-  return lanes::available();
+int bondLaneWidth(int requested) {
+  if (requested >= 8 && lanes::wide()) return 8;
+  if (requested >= 4 && lanes::available()) return 4;
+  return 0;
 }
 
 template <int D>
@@ -227,50 +229,67 @@ void BondForces<D>::compute(BondPass<D>& pass) {
     }
   };
 
+  // W parallel bonds at a time (Lanes: lanes::avx or lanes::avx512). Each group is settled
+  // after the next one is computed: its results are ready by then, and its scalar scatter
+  // overlaps the tail of the next group's chain. A flat joint among the next W goes alone,
+  // on the scalar path. Returns the first bond left (the block's last few).
+  const auto inLanes = [&]<class Settled, class Compute>(std::size_t blk, std::size_t b,
+                                                         std::size_t end, Compute&& compute) {
+    constexpr int W = sizeof(Settled::tensile) / sizeof(double);
+    Settled s[2];
+    int slot = 0;
+    std::size_t pending = end;  // the group computed but not yet settled
+    auto settleGroup = [&](std::size_t first, const Settled& r) {
+      for (int k = 0; k < W; ++k) {
+        if constexpr (D == 3) {
+          settle(blk, first + k, Vec<3>(r.force[0][k], r.force[1][k], r.force[2][k]),
+                 Ang<3>(r.ti[0][k], r.ti[1][k], r.ti[2][k]),
+                 Ang<3>(r.tj[0][k], r.tj[1][k], r.tj[2][k]), r.tensile[k], r.shear[k]);
+        } else {
+          settle(blk, first + k, Vec<2>(r.force[0][k], r.force[1][k]), r.ti[k], r.tj[k],
+                 r.tensile[k], r.shear[k]);
+        }
+      }
+    };
+    auto flush = [&] {
+      if (pending != end) settleGroup(pending, s[slot ^ 1]);
+      pending = end;
+    };
+    while (b + W <= end) {
+      bool plain = true;
+      for (int k = 0; k < W; ++k) plain &= B.face[b + k].empty();
+      if (!plain) {
+        flush();  // in bond order: the breaks of a block stay sorted
+        scalar(blk, b++);
+        continue;
+      }
+      compute(b, s[slot]);
+      if (pending != end) settleGroup(pending, s[slot ^ 1]);
+      pending = b;
+      slot ^= 1;
+      b += W;
+    }
+    flush();
+    return b;
+  };
+  const int width = bondLaneWidth(pass.lane_width);
+  using Settled8 = std::conditional_t<D == 3, lanes::avx512::Settled, lanes::avx512::Settled2>;
+  using Settled4 = std::conditional_t<D == 3, lanes::avx::Settled, lanes::avx::Settled2>;
+
 #pragma omp parallel for schedule(dynamic, 1) num_threads(pass.threads) if (pass.threaded)
   for (std::size_t blk = 0; blk < blocks; ++blk) {
     const std::size_t end = std::min(nb, (blk + 1) * kBlockRows);
     std::size_t b = blk * kBlockRows;
-    if (pass.lanes && lanes::available()) {
-      // Four parallel bonds at a time. Each group is settled after the next one is computed:
-      // its results are ready by then, and its scalar scatter overlaps the tail of the next
-      // group's chain. A flat joint among the next four goes alone, on the scalar path.
-      using Settled = std::conditional_t<D == 3, lanes::Settled, lanes::Settled2>;
-      Settled s[2];
-      int slot = 0;
-      std::size_t pending = end;  // the group computed but not yet settled
-      auto settleFour = [&](std::size_t first, const Settled& r) {
-        for (int k = 0; k < 4; ++k) {
-          if constexpr (D == 3) {
-            settle(blk, first + k, Vec<3>(r.force[0][k], r.force[1][k], r.force[2][k]),
-                   Ang<3>(r.ti[0][k], r.ti[1][k], r.ti[2][k]),
-                   Ang<3>(r.tj[0][k], r.tj[1][k], r.tj[2][k]), r.tensile[k], r.shear[k]);
-          } else {
-            settle(blk, first + k, Vec<2>(r.force[0][k], r.force[1][k]), r.ti[k], r.tj[k],
-                   r.tensile[k], r.shear[k]);
-          }
-        }
-      };
-      auto flush = [&] {
-        if (pending != end) settleFour(pending, s[slot ^ 1]);
-        pending = end;
-      };
-      while (b + 4 <= end) {
-        if (!(B.face[b].empty() && B.face[b + 1].empty() && B.face[b + 2].empty() &&
-              B.face[b + 3].empty())) {
-          flush();  // in bond order: the breaks of a block stay sorted
-          scalar(blk, b++);
-          continue;
-        }
-        lanes::fourBonds(P, B, b, dt, s[slot]);
-        if (pending != end) settleFour(pending, s[slot ^ 1]);
-        pending = b;
-        slot ^= 1;
-        b += 4;
-      }
-      flush();
+    if (width == 8) {
+      b = inLanes.template operator()<Settled8>(blk, b, end, [&](std::size_t first, Settled8& s) {
+        lanes::avx512::bonds(P, B, first, dt, s);
+      });
+    } else if (width == 4) {
+      b = inLanes.template operator()<Settled4>(blk, b, end, [&](std::size_t first, Settled4& s) {
+        lanes::avx::bonds(P, B, first, dt, s);
+      });
     }
-    for (; b < end; ++b) scalar(blk, b);  // no AVX, or the block's last few bonds
+    for (; b < end; ++b) scalar(blk, b);  // no lanes, or the block's last few bonds
   }
 
   if (pass.threaded) {

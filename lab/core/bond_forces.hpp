@@ -35,14 +35,17 @@ struct BondPass {
   std::vector<std::uint32_t> released;
   double slip_energy = 0.0;
 
-  bool lanes = true;  // 3D: four bonds per AVX register where the CPU has it (same bits)
+  // Bonds up to this many per vector register (8, 4; 0: one at a time) where the CPU has the
+  // width: the same bits at any width.
+  int lane_width = 8;
   // The kinds, indexed by BondStore::kind, for their friction angles and moment factors
   // (nullptr: neither).
   const std::vector<BondKind>* kinds = nullptr;
 };
 
 // Whether 3D bonds can run four per AVX register here (BondPass::lanes asks for it).
-bool bondLanesAvailable();
+// The lanes the bond pass runs in for a requested width: 8 (AVX-512), 4 (AVX) or 0.
+int bondLaneWidth(int requested);
 
 template <int D>
 class BondForces {

@@ -30,7 +30,8 @@ struct ContactPass {
   int threads;
   bool track_energy;
   double overlap_limit;  // overlap / smaller radius beyond which the guard trips
-  bool lanes;  // touching pairs four per AVX register where the law and CPU can (same bits)
+  int lane_width;        // touching pairs up to this many per vector register (8, 4; 0: one at a
+                         // time) where the law and the CPU can: the same bits at any width
 
   // Out: energy dissipated in contacts this step (J), and whether an overlap exceeded the
   // limit.
@@ -57,6 +58,13 @@ struct KeptContact {
   bool touching = false;
 };
 
+// A block's touching pairs in pair order, for the lane passes: rows, partners (kCross for a
+// pair another thread computed) and pair slots.
+inline constexpr std::uint32_t kCross = 0xffffffffu;
+struct TouchList {
+  std::vector<std::uint32_t> i, j, p;
+};
+
 // Work space of the force loops, kept between steps to avoid reallocating.
 template <int D>
 struct PairBuffers {
@@ -70,6 +78,7 @@ struct PairBuffers {
   std::vector<double> block_friction, block_viscous, block_cost;
   std::vector<std::uint32_t> block_touching;  // touching pairs per block, last threaded step
   std::vector<std::uint8_t> block_over, thread_over;
+  std::vector<TouchList> touch_lists;  // per thread
 };
 
 template <int D>

@@ -13,6 +13,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "lab/core/contact_lanes.hpp"
@@ -145,69 +146,160 @@ class ContactModelImpl final : public ContactModel<D> {
     torque[j] -= tj;
   }
 
-  // Touching pairs gathered for the lane pass, four at a time in pair order.
+  // Touching pairs gathered for the lane pass, in pair order, as many as the lanes take.
   struct LaneGroup {
-    std::uint32_t is[4], js[4], ps[4];
-    const Params* params[4];
+    std::uint32_t is[8], js[8], ps[8];
+    const Params* params[8];
     int n = 0;
   };
 
-  bool lanesOn(const ContactPass<D>& pass) const {
-    return lanes::LaneLaw<Law>::value && pass.lanes && lanes::available();
+  // The lanes the pass runs its touching pairs in: 8, 4, or 0 (one pair at a time), the
+  // widest the law, the CPU and the pass allow.
+  int laneWidth(const ContactPass<D>& pass) const {
+    if (!lanes::LaneLaw<Law>::value) return 0;
+    if (pass.lane_width >= 8 && lanes::wide()) return 8;
+    if (pass.lane_width >= 4 && lanes::available()) return 4;
+    return 0;
   }
 
-  // Pair p of row i (particle a) touches: the scalar path's test, so both paths take the same
-  // pairs. A pair out of reach loses its history.
-  static bool touches(const PairView& v, const RowParticle& a, std::uint32_t p, std::uint32_t j) {
+  // Pair p of row i (particle a) into the group's next slot; it counts (the group grows)
+  // only if it touches, by the scalar path's test, so both paths take the same pairs. A pair
+  // out of reach loses its history. Nothing branches on the touch: about half the candidates
+  // touch, in no order a predictor learns, and the mispredicted branch per candidate cost
+  // more than its test (perf on the bench scene).
+  [[gnu::always_inline]] bool collect(LaneGroup& g, const PairView& v, const RowParticle& a,
+                                      std::size_t i, std::uint32_t p, std::uint32_t j) const {
     const V d = v.pos[j] - a.x;
     const double reach = a.r + v.radius[j];
-    if (d.squaredNorm() >= reach * reach) {
-      v.shear[p].setZero();
-      return false;
-    }
-    return true;
-  }
-
-  void add(LaneGroup& g, const PairView& v, const RowParticle& a, std::size_t i, std::uint32_t p,
-           std::uint32_t j) const {
+    const bool touch = !(d.squaredNorm() >= reach * reach);
+    keepOnly(v.shear[p], touch);
     g.is[g.n] = static_cast<std::uint32_t>(i);
     g.js[g.n] = j;
     g.ps[g.n] = p;
     g.params[g.n] = &table_(a.material, v.material[j]);
-    ++g.n;
+    g.n += touch;
+    return touch;
   }
 
-  // The group's pairs in lanes, then each applied in order, with its dissipation, as
-  // interact() would have (a short group repeats its first pair in the empty lanes). Only
-  // called where lanesOn().
-  template <bool kEnergy, class Apply>
-  void flush(const PairView& v, LaneGroup& g, ContactDissipation& diss, bool& over,
-             Apply&& apply) const {
-    if constexpr (lanes::LaneLaw<Law>::value) {
-      lanePass<kEnergy>(
-          v, g, [&](int) -> ContactDissipation& { return diss; }, over,
-          [&](int, std::uint32_t i, std::uint32_t j, const V& f, const A& ti, const A& tj) {
-            apply(i, j, f, ti, tj);
-          });
+  // v where keep, else +0 in every component (as setZero), without a branch.
+  [[gnu::always_inline]] static void keepOnly(V& v, bool keep) {
+    const std::uint64_t mask = 0 - static_cast<std::uint64_t>(keep);
+    for (int c = 0; c < D; ++c) {
+      v[c] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(v[c]) & mask);
     }
+  }
+
+  // The lane passes take a block of rows in two phases. First its touching pairs, in pair
+  // order, into a list (touchingPairs); then the list, `width` pairs at a time
+  // (applyTouching). The first phase is a short loop over the candidates that keeps its
+  // variables in registers and branches on nothing; interleaved with the lanes, the same
+  // test was a fifth slower per candidate (its variables spilled around the calls).
+  //
+  // Rows [r0, r1): every candidate's entry is written in turn and the list grows by one
+  // where the pair touches (by the scalar path's test, so both paths take the same pairs) or
+  // is a cross pair (partner at or past `cross_from`: computed apart by the threaded pass,
+  // and entered with j = kCross to be applied in its place). A pair out of reach loses its
+  // history. Returns the list's length.
+  static std::size_t touchingPairs(const PairView& v, const std::uint32_t* row, std::size_t r0,
+                                   std::size_t r1, std::size_t cross_from, TouchList& list) {
+    const std::size_t candidates = row[r1] - row[r0];
+    if (list.i.size() < candidates) {
+      list.i.resize(candidates);
+      list.j.resize(candidates);
+      list.p.resize(candidates);
+    }
+    std::uint32_t* li = list.i.data();
+    std::uint32_t* lj = list.j.data();
+    std::uint32_t* lp = list.p.data();
+    std::size_t m = 0;
+    for (std::size_t i = r0; i < r1; ++i) {
+      const V x = v.pos[i];
+      const double r = v.radius[i];
+      for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+        const std::uint32_t j = v.col[p];
+        const V d = v.pos[j] - x;
+        const double reach = r + v.radius[j];
+        const bool cross = j >= cross_from;
+        const bool keep = !(d.squaredNorm() >= reach * reach) || cross;
+        keepOnly(v.shear[p], keep);
+        li[m] = static_cast<std::uint32_t>(i);
+        lj[m] = cross ? kCross : j;
+        lp[m] = p;
+        m += keep;
+      }
+    }
+    return m;
+  }
+
+  // The list's first m pairs applied in order, `width` at a time; a cross pair's entry hands
+  // its row to crossPair(i, diss) after the pairs before it. Returns the touching pairs
+  // (cross pairs apart).
+  template <bool kEnergy, class CrossPair>
+  std::uint32_t applyTouching(const PairView& v, const TouchList& list, std::size_t m, int width,
+                              ContactDissipation& diss, bool& over, V* force, A* torque,
+                              CrossPair&& crossPair) const {
+    const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti, const A& tj) {
+      scatter(force, torque, i, j, f, ti, tj);
+    };
+    LaneGroup g;
+    std::uint32_t touching = 0;
+    for (std::size_t e = 0; e < m; ++e) {
+      const std::uint32_t i = list.i[e], j = list.j[e];
+      if (j == kCross) {  // the pending pairs come first in pair order
+        flush<kEnergy>(v, g, width, diss, over, apply);
+        crossPair(i, diss);
+        continue;
+      }
+      ++touching;
+      g.is[g.n] = i;
+      g.js[g.n] = j;
+      g.ps[g.n] = list.p[e];
+      g.params[g.n] = &table_(v.material[i], v.material[j]);
+      if (++g.n == width) flush<kEnergy>(v, g, width, diss, over, apply);
+    }
+    flush<kEnergy>(v, g, width, diss, over, apply);
+    return touching;
+  }
+
+  // The group's pairs in `width` lanes, then each applied in order, with its dissipation, as
+  // interact() would have (a short group repeats its first pair in the empty lanes). Only
+  // called where laneWidth() is not 0.
+  template <bool kEnergy, class Apply>
+  void flush(const PairView& v, LaneGroup& g, int width, ContactDissipation& diss, bool& over,
+             Apply&& apply) const {
+    lanePass<kEnergy>(
+        v, g, width, [&](int) -> ContactDissipation& { return diss; }, over,
+        [&](int, std::uint32_t i, std::uint32_t j, const V& f, const A& ti, const A& tj) {
+          apply(i, j, f, ti, tj);
+        });
   }
 
   // The same for pairs kept apart (the threaded pass's cross pairs): lane k's dissipation
   // goes to dissOf(k) and its force to apply(k, ...).
   template <bool kEnergy, class DissOf, class Apply>
-  void flushEach(const PairView& v, LaneGroup& g, DissOf&& dissOf, bool& over,
-                 Apply&& apply) const {
-    if constexpr (lanes::LaneLaw<Law>::value) lanePass<kEnergy>(v, g, dissOf, over, apply);
+  void lanePass(const PairView& v, LaneGroup& g, int width, DissOf&& dissOf, bool& over,
+                Apply&& apply) const {
+    if constexpr (lanes::LaneLaw<Law>::value) {
+      if (g.n == 0) return;
+      if (width == 8) {
+        inLanes<lanes::avx512::ContactsOut, kEnergy>(v, g, dissOf, over, apply);
+      } else {
+        inLanes<lanes::avx::ContactsOut, kEnergy>(v, g, dissOf, over, apply);
+      }
+    }
   }
 
-  template <bool kEnergy, class DissOf, class Apply>
-  void lanePass(const PairView& v, LaneGroup& g, DissOf&& dissOf, bool& over, Apply&& apply) const {
-    if (g.n == 0) return;
-    for (int k = g.n; k < 4; ++k) {
+  template <class Out, bool kEnergy, class DissOf, class Apply>
+  void inLanes(const PairView& v, LaneGroup& g, DissOf&& dissOf, bool& over, Apply&& apply) const {
+    for (int k = g.n; k < Out::width; ++k) {
       g.is[k] = g.is[0], g.js[k] = g.js[0], g.ps[k] = g.ps[0], g.params[k] = g.params[0];
     }
-    lanes::ContactsOut out;
-    lanes::fourContacts<D, Law, kEnergy>(v, g.is, g.js, g.ps, g.params, g.n, out);
+    Out out;
+    if constexpr (Out::width == 8) {
+      lanes::avx512::contacts<D, Law, kEnergy>(v, g.is, g.js, g.ps, g.params, g.n, out);
+    } else {
+      lanes::avx::contacts<D, Law, kEnergy>(v, g.is, g.js, g.ps, g.params, g.n, out);
+    }
     for (int k = 0; k < g.n; ++k) {
       if constexpr (kEnergy) {
         ContactDissipation& diss = dissOf(k);
@@ -261,25 +353,18 @@ class ContactModelImpl final : public ContactModel<D> {
     const PairView v = viewOf(pass);
     V* force = P.force.data();
     A* torque = P.torque.data();
-    const bool lanes_on = lanesOn(pass);
+    const int width = laneWidth(pass);
+    const bool lanes_on = width > 0;
+    buffers_.touch_lists.resize(1);
     for (std::size_t b = 0; b < blocks; ++b) {
       ContactDissipation diss;
       bool over = false;  // not a uint8_t: a char store may alias anything
       const std::size_t i_end = std::min(n, (b + 1) * kBlockRows);
       if (lanes_on) {
-        LaneGroup g;
-        const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti,
-                               const A& tj) { scatter(force, torque, i, j, f, ti, tj); };
-        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
-          const RowParticle a = rowParticle(v, i);
-          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-            const std::uint32_t j = v.col[p];
-            if (!touches(v, a, p, j)) continue;
-            add(g, v, a, i, p, j);
-            if (g.n == 4) flush<kEnergy>(v, g, diss, over, apply);
-          }
-        }
-        flush<kEnergy>(v, g, diss, over, apply);
+        TouchList& list = buffers_.touch_lists[0];
+        const std::size_t m = touchingPairs(v, row, b * kBlockRows, i_end, n, list);
+        applyTouching<kEnergy>(v, list, m, width, diss, over, force, torque,
+                               [](std::uint32_t, ContactDissipation&) {});
       } else {
         for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
           const RowParticle a = rowParticle(v, i);
@@ -335,12 +420,16 @@ class ContactModelImpl final : public ContactModel<D> {
     B.own_cross_row.resize(threads);
     B.cross_start.assign(threads + 1, 0);
     B.thread_over.assign(threads, 0);
+    B.touch_lists.resize(threads);
     const PairView v = viewOf(pass);
     V* force = P.force.data();
     A* torque = P.torque.data();
-    const bool lanes_on = lanesOn(pass);
+    const int width = laneWidth(pass);
+    const bool lanes_on = width > 0;
 
-#pragma omp parallel num_threads(threads)
+    // Each thread its own copy of what the loops read: through the shared frame the compiler
+    // read them again for every pair (the stores into the pairs' springs could alias them).
+#pragma omp parallel num_threads(threads) firstprivate(v, force, torque, row, col, width, lanes_on)
     {
       const int t = omp_get_thread_num();
       const std::size_t lo = B.range[t], hi = B.range[t + 1];
@@ -379,7 +468,7 @@ class ContactModelImpl final : public ContactModel<D> {
         const std::size_t m = B.cross.size();
         const std::size_t first = m * t / threads, last = m * (t + 1) / threads;
         LaneGroup group;
-        std::size_t slot[4];  // the group's pairs in cross_result
+        std::size_t slot[8];  // the group's pairs in cross_result
         const auto dissOf = [&](int k) -> ContactDissipation& {
           return B.cross_result[slot[k]].diss;
         };
@@ -396,18 +485,16 @@ class ContactModelImpl final : public ContactModel<D> {
           const std::uint32_t i = B.cross_row[g], p = B.cross[g];
           const RowParticle a = rowParticle(v, i);
           if (lanes_on) {
-            c.touching = touches(v, a, p, col[p]);
-            if (!c.touching) continue;
             slot[group.n] = g;
-            add(group, v, a, i, p, col[p]);
-            if (group.n == 4) flushEach<kEnergy>(v, group, dissOf, cross_over, keep);
+            c.touching = collect(group, v, a, i, p, col[p]);
+            if (group.n == width) lanePass<kEnergy>(v, group, width, dissOf, cross_over, keep);
             continue;
           }
           c.touching = interact<kEnergy>(
               v, a, p, c.diss, cross_over,
               [&](std::uint32_t, const V& f, const A& ti, const A& tj) { store(c, f, ti, tj); });
         }
-        flushEach<kEnergy>(v, group, dissOf, cross_over, keep);
+        lanePass<kEnergy>(v, group, width, dissOf, cross_over, keep);
       }
       B.thread_over[t] = cross_over;
 #pragma omp barrier  // every cross pair is ready before the partners' shares are read
@@ -433,41 +520,39 @@ class ContactModelImpl final : public ContactModel<D> {
         ContactDissipation diss;
         bool over = false;
         std::uint32_t touching = 0;
-        LaneGroup group;
-        const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti,
-                               const A& tj) { scatter(force, torque, i, j, f, ti, tj); };
+        // A cross pair's own share, in its place in pair order.
+        const auto crossPair = [&](std::size_t i, ContactDissipation& d) {
+          const KeptContact<D>& kept = B.cross_result[g++];
+          if (!kept.touching) return;
+          if constexpr (kEnergy) {
+            d.friction += kept.diss.friction;
+            d.viscous += kept.diss.viscous;
+          }
+          force[i] -= kept.f.force;
+          torque[i] -= kept.f.torque_i;
+        };
         const std::size_t i_end = std::min(hi, (b + 1) * kBlockRows);
-        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
-          const RowParticle a = rowParticle(v, i);
-          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-            const std::uint32_t j = col[p];
-            if (j >= hi) {
-              // The pending pairs come first in pair order: theirs before this one's share.
-              flush<kEnergy>(v, group, diss, over, apply);
-              const KeptContact<D>& kept = B.cross_result[g++];
-              if (!kept.touching) continue;
-              if constexpr (kEnergy) {
-                diss.friction += kept.diss.friction;
-                diss.viscous += kept.diss.viscous;
+        if (lanes_on) {
+          TouchList& list = B.touch_lists[t];
+          const std::size_t m = touchingPairs(v, row, b * kBlockRows, i_end, hi, list);
+          touching =
+              applyTouching<kEnergy>(v, list, m, width, diss, over, force, torque, crossPair);
+        } else {
+          for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
+            const RowParticle a = rowParticle(v, i);
+            for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+              const std::uint32_t j = col[p];
+              if (j >= hi) {
+                crossPair(i, diss);
+                continue;
               }
-              force[i] -= kept.f.force;
-              torque[i] -= kept.f.torque_i;
-              continue;
+              touching += interact<kEnergy>(
+                  v, a, p, diss, over, [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
+                    scatter(force, torque, i, j, f, ti, tj);
+                  });
             }
-            if (lanes_on) {
-              if (!touches(v, a, p, j)) continue;
-              ++touching;
-              add(group, v, a, i, p, j);
-              if (group.n == 4) flush<kEnergy>(v, group, diss, over, apply);
-              continue;
-            }
-            touching += interact<kEnergy>(v, a, p, diss, over,
-                                          [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
-                                            scatter(force, torque, i, j, f, ti, tj);
-                                          });
           }
         }
-        flush<kEnergy>(v, group, diss, over, apply);
         storeBlock(b, diss, over);
         B.block_touching[b] = touching;
       }

@@ -1,15 +1,22 @@
 #pragma once
-// Four doubles at once, one per lane of an AVX register: the types and operations the lane
-// passes share (bond_lanes.hpp, contact_lanes.hpp).
+// Several doubles at once, one per lane of a vector register: the types and operations the
+// lane passes share (bond_lanes.hpp, contact_lanes.hpp). Two widths:
+//   avx     four lanes (__m256d), on any CPU with AVX;
+//   avx512  eight lanes (__m512d), on a CPU with AVX-512F. The contact pass is bound by the
+//           latency of each pair's chain of roots and divisions, not by their throughput:
+//           eight chains side by side finish in about the time of four (contact_lanes.hpp).
 //
-// Each AVX operation here (add, multiply, divide, square root) is the correctly rounded IEEE
+// Each vector operation here (add, multiply, divide, square root) is the correctly rounded IEEE
 // operation, as the scalar one; nothing is fused (-ffp-contract=off, no FMA target). A lane
-// pass that performs the scalar path's operations in the same order gets the same bits, and
-// the benchmark's state hash holds. Where the scalar code branches, both sides are computed
-// and each lane takes its own with a mask. The dot and cross products keep Eigen's order.
+// pass that performs the scalar path's operations in the same order gets the same bits at
+// either width, and the benchmark's state hash holds. Where the scalar code branches, both
+// sides are computed and each lane takes its own with a mask. The dot and cross products keep
+// Eigen's order.
 //
-// The functions carry the AVX target themselves (the rest of the binary stays x86-64
-// baseline); the passes call them only when the CPU has AVX (lanes::available()).
+// Each width's functions carry their target themselves (the rest of the binary stays x86-64
+// baseline); the passes call them only when the CPU has it (available(), wide()). The
+// operations on vectors of lanes (lane_vectors.inc) are written once and compiled for each
+// width inside its namespace and target, as its `L` and `Mask` are.
 
 #include <immintrin.h>
 
@@ -19,75 +26,78 @@
 
 namespace rocklab::lanes {
 
+// The CPU has AVX: the four-lane passes can run.
 inline bool available() {
   static const bool avx = __builtin_cpu_supports("avx");
   return avx;
 }
 
+// The CPU (and the system, which saves the registers) has AVX-512F: eight lanes can run.
+inline bool wide() {
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  return avx512;
+}
+
 #pragma GCC push_options
 #pragma GCC target("avx")
 
+namespace avx {
+
 // Four doubles: lane k the group's k-th bond or contact.
-struct L4 {
+struct L {
   __m256d v;
+  static constexpr int width = 4;
 };
-inline L4 both(double a) {
+using Mask = __m256d;  // all bits set in a lane where true
+
+inline L both(double a) {
   return {_mm256_set1_pd(a)};
 }
-inline L4 load(const double* p) {  // p[k] to lane k
+inline L load(const double* p) {  // p[k] to lane k
   return {_mm256_loadu_pd(p)};
 }
-inline L4 operator+(L4 a, L4 b) {
+inline void store(L a, double* p) {  // lane k to p[k]; p aligned to 32 bytes
+  _mm256_store_pd(p, a.v);
+}
+inline L operator+(L a, L b) {
   return {_mm256_add_pd(a.v, b.v)};
 }
-inline L4 operator-(L4 a, L4 b) {
+inline L operator-(L a, L b) {
   return {_mm256_sub_pd(a.v, b.v)};
 }
-inline L4 operator*(L4 a, L4 b) {
+inline L operator*(L a, L b) {
   return {_mm256_mul_pd(a.v, b.v)};
 }
-inline L4 operator/(L4 a, L4 b) {
+inline L operator/(L a, L b) {
   return {_mm256_div_pd(a.v, b.v)};
 }
-inline L4 operator-(L4 a) {  // flips the sign bit, as scalar negation
+inline L operator-(L a) {  // flips the sign bit, as scalar negation
   return {_mm256_xor_pd(a.v, _mm256_set1_pd(-0.0))};
 }
-inline L4 sqrt(L4 a) {
+inline L sqrt(L a) {
   return {_mm256_sqrt_pd(a.v)};
 }
-inline L4 abs(L4 a) {
+inline L abs(L a) {
   return {_mm256_andnot_pd(_mm256_set1_pd(-0.0), a.v)};
 }
 // Lane by lane: a where the mask is set, else b.
-inline L4 select(__m256d mask, L4 a, L4 b) {
+inline L select(Mask mask, L a, L b) {
   return {_mm256_blendv_pd(b.v, a.v, mask)};
 }
-
-// A 3-vector of four bonds or contacts, component by component.
-struct V3 {
-  L4 x, y, z;
-};
-inline V3 operator+(const V3& a, const V3& b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
+inline Mask less(L a, L b) {  // a < b, false on NaN as in C++
+  return _mm256_cmp_pd(a.v, b.v, _CMP_LT_OQ);
 }
-inline V3 operator-(const V3& a, const V3& b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
+inline Mask greater(L a, L b) {  // a > b
+  return _mm256_cmp_pd(a.v, b.v, _CMP_GT_OQ);
 }
-inline V3 operator*(L4 s, const V3& a) {
-  return {s * a.x, s * a.y, s * a.z};
+inline Mask equal(L a, L b) {  // a == b
+  return _mm256_cmp_pd(a.v, b.v, _CMP_EQ_OQ);
 }
-inline V3 operator/(const V3& a, L4 s) {
-  return {a.x / s, a.y / s, a.z / s};
+inline Mask notEqual(L a, L b) {  // a != b, true on NaN as in C++
+  return _mm256_cmp_pd(a.v, b.v, _CMP_NEQ_UQ);
 }
-// Eigen's order for 3-vectors: (a0 b0 + a1 b1) + a2 b2.
-inline L4 dot(const V3& a, const V3& b) {
-  return (a.x * b.x + a.y * b.y) + a.z * b.z;
-}
-inline V3 cross(const V3& a, const V3& b) {  // Eigen's formula
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-inline V3 select(__m256d mask, const V3& a, const V3& b) {
-  return {select(mask, a.x, b.x), select(mask, a.y, b.y), select(mask, a.z, b.z)};
+inline int bits(Mask m) {  // bit k: lane k
+  return _mm256_movemask_pd(m);
 }
 
 // Rows r0..r3 become columns: out[c] holds element c of each row, lane k from row k.
@@ -100,76 +110,141 @@ inline void transpose(__m256d r0, __m256d r1, __m256d r2, __m256d r3, __m256d (&
   out[3] = _mm256_permute2f128_pd(t1, t3, 0x31);
 }
 
-// The 3-vectors a[idx[k]] of four particles into lanes. A masked load reads the three
-// doubles and nothing past them (the last particle's vector ends the array).
-[[gnu::always_inline]] inline V3 gather(const Eigen::Vector3d* a, const std::uint32_t (&idx)[4]) {
+// The 3-vectors a[idx[k]] of four particles, component by component. A masked load reads the
+// three doubles and nothing past them (the last particle's vector ends the array).
+[[gnu::always_inline]] inline void gather3(const Eigen::Vector3d* a, const std::uint32_t* idx,
+                                           __m256d (&c)[4]) {
   const __m256i xyz = _mm256_set_epi64x(0, -1, -1, -1);
-  __m256d c[4];
   transpose(_mm256_maskload_pd(a[idx[0]].data(), xyz), _mm256_maskload_pd(a[idx[1]].data(), xyz),
             _mm256_maskload_pd(a[idx[2]].data(), xyz), _mm256_maskload_pd(a[idx[3]].data(), xyz),
             c);
-  return {{c[0]}, {c[1]}, {c[2]}};
 }
-[[gnu::always_inline]] inline L4 gather(const double* a, const std::uint32_t (&idx)[4]) {
+[[gnu::always_inline]] inline L gather(const double* a, const std::uint32_t* idx) {
   return {_mm256_set_pd(a[idx[3]], a[idx[2]], a[idx[1]], a[idx[0]])};
 }
-
-// followContactFrame (contact_kernels.hpp), both of its branches masked.
-inline void followContactFrame(V3& v, const V3& n, L4 spin_n, double dt) {
-  const L4 m2 = dot(v, v);
-  V3 w = v + (both(dt) * spin_n) * cross(n, v);
-  w = w - dot(w, n) * n;
-  const L4 m2_new = dot(w, w);
-  const __m256d turned = _mm256_cmp_pd(m2_new.v, _mm256_setzero_pd(), _CMP_GT_OQ);
-  // A lane with m2_new = 0 divides by zero here; select drops it.
-  w = select(turned, sqrt(m2 / m2_new) * w, w);
-  v = select(_mm256_cmp_pd(m2.v, _mm256_setzero_pd(), _CMP_EQ_OQ), v, w);
+[[gnu::always_inline]] inline void gather2(const Eigen::Vector2d* a, const std::uint32_t* idx, L& x,
+                                           L& y) {
+  x = {_mm256_set_pd(a[idx[3]].x(), a[idx[2]].x(), a[idx[1]].x(), a[idx[0]].x())};
+  y = {_mm256_set_pd(a[idx[3]].y(), a[idx[2]].y(), a[idx[1]].y(), a[idx[0]].y())};
+}
+// A field of four structs into lanes.
+template <class P>
+[[gnu::always_inline]] inline L field(const P* const* p, double P::*member) {
+  return {_mm256_set_pd(p[3]->*member, p[2]->*member, p[1]->*member, p[0]->*member)};
 }
 
-// In-plane vectors of four (2D): x and y, spins and moments being scalars.
-struct V2 {
-  L4 x, y;
-};
-inline V2 operator+(const V2& a, const V2& b) {
-  return {a.x + b.x, a.y + b.y};
-}
-inline V2 operator-(const V2& a, const V2& b) {
-  return {a.x - b.x, a.y - b.y};
-}
-inline V2 operator*(L4 s, const V2& a) {
-  return {s * a.x, s * a.y};
-}
-inline V2 operator/(const V2& a, L4 s) {
-  return {a.x / s, a.y / s};
-}
-inline L4 dot(const V2& a, const V2& b) {  // Eigen's order: a0 b0 + a1 b1
-  return a.x * b.x + a.y * b.y;
-}
-inline V2 cross(L4 w, const V2& r) {  // w x r, dim.hpp
-  return {-w * r.y, w * r.x};
-}
-inline L4 cross(const V2& a, const V2& b) {  // the out-of-plane component, dim.hpp
-  return a.x * b.y - a.y * b.x;
-}
-inline V2 select(__m256d mask, const V2& a, const V2& b) {
-  return {select(mask, a.x, b.x), select(mask, a.y, b.y)};
-}
-[[gnu::always_inline]] inline V2 gather(const Eigen::Vector2d* a, const std::uint32_t (&idx)[4]) {
-  return {{_mm256_set_pd(a[idx[3]].x(), a[idx[2]].x(), a[idx[1]].x(), a[idx[0]].x())},
-          {_mm256_set_pd(a[idx[3]].y(), a[idx[2]].y(), a[idx[1]].y(), a[idx[0]].y())}};
-}
+#include "lab/core/lane_vectors.inc"
 
-// followContactFrame<2>: the spring leaves the normal's direction at its length, both
-// branches masked.
-inline void followContactFrame(V2& v, const V2& n) {
-  const L4 m2 = dot(v, v);
-  V2 w = v - dot(v, n) * n;
-  const L4 m2_new = dot(w, w);
-  const __m256d turned = _mm256_cmp_pd(m2_new.v, _mm256_setzero_pd(), _CMP_GT_OQ);
-  w = select(turned, sqrt(m2 / m2_new) * w, w);
-  v = select(_mm256_cmp_pd(m2.v, _mm256_setzero_pd(), _CMP_EQ_OQ), v, w);
-}
+}  // namespace avx
 
 #pragma GCC pop_options
+
+#pragma GCC push_options
+#pragma GCC target("avx512f")
+
+namespace avx512 {
+
+// Eight doubles: lane k the group's k-th contact.
+struct L {
+  __m512d v;
+  static constexpr int width = 8;
+};
+using Mask = __mmask8;  // bit k set where lane k is true
+
+inline L both(double a) {
+  return {_mm512_set1_pd(a)};
+}
+inline L load(const double* p) {
+  return {_mm512_loadu_pd(p)};
+}
+inline void store(L a, double* p) {  // p aligned to 64 bytes
+  _mm512_store_pd(p, a.v);
+}
+inline L operator+(L a, L b) {
+  return {_mm512_add_pd(a.v, b.v)};
+}
+inline L operator-(L a, L b) {
+  return {_mm512_sub_pd(a.v, b.v)};
+}
+inline L operator*(L a, L b) {
+  return {_mm512_mul_pd(a.v, b.v)};
+}
+inline L operator/(L a, L b) {
+  return {_mm512_div_pd(a.v, b.v)};
+}
+inline L operator-(L a) {  // flips the sign bit (integer xor: AVX-512F has no xor_pd)
+  return {_mm512_castsi512_pd(
+      _mm512_xor_si512(_mm512_castpd_si512(a.v), _mm512_set1_epi64(INT64_MIN)))};
+}
+// The zero-masking forms with every lane set: the plain ones read an undefined register that
+// GCC 12 warns about.
+inline L sqrt(L a) {
+  return {_mm512_maskz_sqrt_pd(0xff, a.v)};
+}
+inline L abs(L a) {
+  return {_mm512_abs_pd(a.v)};
+}
+inline L select(Mask mask, L a, L b) {
+  return {_mm512_mask_blend_pd(mask, b.v, a.v)};
+}
+inline Mask less(L a, L b) {
+  return _mm512_cmp_pd_mask(a.v, b.v, _CMP_LT_OQ);
+}
+inline Mask greater(L a, L b) {
+  return _mm512_cmp_pd_mask(a.v, b.v, _CMP_GT_OQ);
+}
+inline Mask equal(L a, L b) {
+  return _mm512_cmp_pd_mask(a.v, b.v, _CMP_EQ_OQ);
+}
+inline Mask notEqual(L a, L b) {
+  return _mm512_cmp_pd_mask(a.v, b.v, _CMP_NEQ_UQ);
+}
+inline int bits(Mask m) {
+  return m;
+}
+
+// Two halves of four lanes into eight.
+inline __m512d join(__m256d lo, __m256d hi) {
+  return _mm512_maskz_insertf64x4(0xff, _mm512_castpd256_pd512(lo), hi, 1);
+}
+[[gnu::always_inline]] inline void gather3(const Eigen::Vector3d* a, const std::uint32_t* idx,
+                                           __m512d (&c)[4]) {
+  __m256d lo[4], hi[4];
+  avx::gather3(a, idx, lo);
+  avx::gather3(a, idx + 4, hi);
+  for (int k = 0; k < 3; ++k) c[k] = join(lo[k], hi[k]);
+}
+[[gnu::always_inline]] inline L gather(const double* a, const std::uint32_t* idx) {
+  return {_mm512_set_pd(a[idx[7]], a[idx[6]], a[idx[5]], a[idx[4]], a[idx[3]], a[idx[2]], a[idx[1]],
+                        a[idx[0]])};
+}
+[[gnu::always_inline]] inline void gather2(const Eigen::Vector2d* a, const std::uint32_t* idx, L& x,
+                                           L& y) {
+  avx::L xl, yl, xh, yh;
+  avx::gather2(a, idx, xl, yl);
+  avx::gather2(a, idx + 4, xh, yh);
+  x = {join(xl.v, xh.v)};
+  y = {join(yl.v, yh.v)};
+}
+template <class P>
+[[gnu::always_inline]] inline L field(const P* const* p, double P::*member) {
+  return {_mm512_set_pd(p[7]->*member, p[6]->*member, p[5]->*member, p[4]->*member, p[3]->*member,
+                        p[2]->*member, p[1]->*member, p[0]->*member)};
+}
+
+#include "lab/core/lane_vectors.inc"
+
+}  // namespace avx512
+
+#pragma GCC pop_options
+
+// The four-lane names the bond pass uses.
+using L4 = avx::L;
+using V3 = avx::V3;
+using V2 = avx::V2;
+using avx::both;
+using avx::gather;
+using avx::load;
+using avx::transpose;
 
 }  // namespace rocklab::lanes

@@ -221,7 +221,7 @@ bool Simulation<D>::computeForces(double history_dt) {
                       config_.threads,
                       config_.track_energy,
                       config_.guard.overlap_limit,
-                      config_.contact_lanes};
+                      config_.contact_lane_width};
   {
     const StageClock clock(&stages_[kContacts]);
     model_->computeForces(pass);

@@ -69,12 +69,13 @@ struct SimulationConfig {
   // false: bonds carry any load unbroken (an ultrasonic window: microseconds in which the
   // lab sample breaks nothing, while a DEM sample loaded fast keeps breaking for long).
   bool bond_breakage = true;
-  // false: bonds one at a time. The four-lane pass (bond_lanes.hpp, 2D and 3D) gives the same bits,
-  // so this only changes the speed; the tests compare the two.
-  bool bond_lanes = true;
-  // false: touching pairs one at a time; the four-lane pass (contact_lanes.hpp) gives the same
-  // bits, as for bonds.
-  bool contact_lanes = true;
+  // Bonds up to this many per vector register (bond_lanes.hpp, 2D and 3D: 8 with AVX-512, 4
+  // with AVX), or one at a time (0): the same bits at any width, so this only changes the
+  // speed; the tests compare them.
+  int bond_lane_width = 8;
+  // Touching pairs up to this many per vector register (contact_lanes.hpp: 8 with AVX-512, 4
+  // with AVX), or one at a time (0): the same bits at any width, as for bonds.
+  int contact_lane_width = 8;
 
   // The fields a protocol sets, with their keys (the contact law in the material section).
   template <class F>

@@ -18,7 +18,7 @@ void Simulation<D>::computeBondForces(double dt) {
   const StageClock clock(&stages_[kBonds]);
   auto& P = particles_;
   BondPass<D> pass{P, bonds_, dt, threaded(), config_.threads, config_.bond_breakage};
-  pass.lanes = config_.bond_lanes;
+  pass.lane_width = config_.bond_lane_width;
   pass.kinds = &bond_kinds_;
   bond_forces_.compute(pass);
   ledger_.friction += pass.slip_energy;

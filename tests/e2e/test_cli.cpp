@@ -108,7 +108,7 @@ TEST(Cli, BenchVariantsTileBondFlowAndRender) {
   const auto scalar = run("bench --packing " + packing +
                           " --bonded --scalar-bonds --threads 1 --steps 20 --warmup 5 --json");
   ASSERT_EQ(scalar.status, 0) << scalar.out;
-  EXPECT_NE(scalar.out.find("\"bond_lanes\": false"), std::string::npos) << scalar.out;
+  EXPECT_NE(scalar.out.find("\"bond_lane_width\": 0"), std::string::npos) << scalar.out;
   for (auto it = std::sregex_iterator(scalar.out.begin(), scalar.out.end(), hash);
        it != std::sregex_iterator(); ++it) {
     hashes.push_back((*it)[1]);

@@ -312,7 +312,7 @@ TEST(Bonds, SurviveReorderingAndOrientationSwaps) {
   }
 }
 
-// What a shaken bonded sample ends in, to compare the four-lane bond pass with the scalar one.
+// What a shaken bonded sample ends in, to compare the bond lanes with the scalar pass.
 template <int D>
 struct LaneOutcome {
   std::vector<Vec<D>> pos, vel;
@@ -339,35 +339,35 @@ LaneOutcome<D> outcomeOf(const Simulation<D>& sim, std::uint32_t kind) {
 }
 
 template <int D>
-void expectSameBits(const LaneOutcome<D>& scalar, const LaneOutcome<D>& four) {
+void expectSameBits(const LaneOutcome<D>& scalar, const LaneOutcome<D>& lanes) {
   EXPECT_GT(scalar.broken, 10u);
-  EXPECT_EQ(four.broken, scalar.broken);
-  EXPECT_EQ(four.break_stress, scalar.break_stress);
-  ASSERT_EQ(four.pos.size(), scalar.pos.size());
+  EXPECT_EQ(lanes.broken, scalar.broken);
+  EXPECT_EQ(lanes.break_stress, scalar.break_stress);
+  ASSERT_EQ(lanes.pos.size(), scalar.pos.size());
   for (std::size_t i = 0; i < scalar.pos.size(); ++i) {
-    ASSERT_EQ(four.pos[i], scalar.pos[i]) << "particle " << i;
-    ASSERT_EQ(four.vel[i], scalar.vel[i]) << "particle " << i;
-    ASSERT_EQ(four.spin[i], scalar.spin[i]) << "particle " << i;
+    ASSERT_EQ(lanes.pos[i], scalar.pos[i]) << "particle " << i;
+    ASSERT_EQ(lanes.vel[i], scalar.vel[i]) << "particle " << i;
+    ASSERT_EQ(lanes.spin[i], scalar.spin[i]) << "particle " << i;
   }
-  ASSERT_EQ(four.loads.size(), scalar.loads.size());
+  ASSERT_EQ(lanes.loads.size(), scalar.loads.size());
   for (std::size_t b = 0; b < scalar.loads.size(); ++b) {
-    const BondLoad<D>&l = four.loads[b], &r = scalar.loads[b];
+    const BondLoad<D>&l = lanes.loads[b], &r = scalar.loads[b];
     ASSERT_TRUE(l.fn == r.fn && l.fs == r.fs && l.mb == r.mb && l.mt == r.mt) << "bond " << b;
   }
 }
 
-// The four-lane bond pass (bond_lanes.hpp) against bonds one at a time, bit for bit: a
-// jittered lattice of 7 x 5 x 4 spheres (bonds with gaps and overlaps, a count that leaves
-// a scalar tail after the groups of four), shaken with random velocities and spins so that
+// The bond pass four and eight per register (bond_lanes.hpp) against bonds one at a time, bit
+// for bit: a jittered lattice of 7 x 5 x 4 spheres (bonds with gaps and overlaps, a count that
+// leaves a scalar tail after the groups), shaken with random velocities and spins so that
 // every mode loads and bonds break. Runs under the sanitizers too (the lanes read particles
 // with masked loads). With a friction angle and a moment factor, the shear strengths and
 // the peak stresses come from the loads the lanes stored.
-TEST(BondLanes, FourPerRegisterGiveTheScalarBits) {
-  auto run = [](bool lanes) {
+TEST(BondLanes, FourAndEightPerRegisterGiveTheScalarBits) {
+  auto run = [](int width) {
     SimulationConfig cfg = testing::undamped();
     cfg.timestep.automatic = false;
     cfg.timestep.fixed_dt = kDt;
-    cfg.bond_lanes = lanes;
+    cfg.bond_lane_width = width;
     Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), cfg);
     Rng rng(5);
     for (int x = 0; x < 7; ++x) {
@@ -394,17 +394,19 @@ TEST(BondLanes, FourPerRegisterGiveTheScalarBits) {
     for (int s = 0; s < 400; ++s) sim.step();
     return outcomeOf(sim, kind);
   };
-  expectSameBits(run(false), run(true));
+  const auto scalar = run(0);
+  expectSameBits(scalar, run(4));
+  expectSameBits(scalar, run(8));  // four again where the CPU lacks AVX-512
 }
 
-// The 2D four-lane pass against bonds one at a time, bit for bit, as the 3D one above: a
-// jittered lattice of 11 x 9 disks shaken so that bonds break in both modes.
-TEST(BondLanes, FourPerRegisterGiveTheScalarBitsIn2D) {
-  auto run = [](bool lanes) {
+// The 2D lanes against bonds one at a time, bit for bit, as the 3D ones above: a jittered
+// lattice of 11 x 9 disks shaken so that bonds break in both modes.
+TEST(BondLanes, FourAndEightPerRegisterGiveTheScalarBitsIn2D) {
+  auto run = [](int width) {
     SimulationConfig cfg = testing::undamped();
     cfg.timestep.automatic = false;
     cfg.timestep.fixed_dt = kDt;
-    cfg.bond_lanes = lanes;
+    cfg.bond_lane_width = width;
     Simulation<2> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), cfg);
     sim.particles().thickness = 2 * kR;
     Rng rng(7);
@@ -430,7 +432,9 @@ TEST(BondLanes, FourPerRegisterGiveTheScalarBitsIn2D) {
     for (int s = 0; s < 400; ++s) sim.step();
     return outcomeOf(sim, kind);
   };
-  expectSameBits(run(false), run(true));
+  const auto scalar = run(0);
+  expectSameBits(scalar, run(4));
+  expectSameBits(scalar, run(8));
 }
 
 TEST(Bonds, KindsAreValidated) {

@@ -352,14 +352,14 @@ struct Outcome {
   std::uint64_t hash = 0;
 };
 
-// Flat joints among parallel bonds: the four-lane pass (which sends each flat joint down the
+// Flat joints among parallel bonds: the lane pass (which sends each flat joint down the
 // scalar path) on two threads gives the bits of bonds one at a time on one.
 TEST(FlatJointPass, LanesAndThreadsGiveTheSerialBitsWithJointsAmongTheBonds) {
   auto run = [](bool lanes, int threads) {
     SimulationConfig cfg = testing::undamped();
     cfg.timestep.automatic = false;
     cfg.timestep.fixed_dt = kDt;
-    cfg.bond_lanes = lanes;
+    cfg.bond_lane_width = lanes ? 8 : 0;
     cfg.threads = threads;
     Simulation<3> sim(testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), cfg);
     Rng rng(11);

@@ -65,7 +65,7 @@ RunBits bitsOf(const Simulation<D>& sim) {
   return {sim.stateHash(), l.friction, l.viscous};
 }
 
-RunBits compressed(int threads, int dim_steps, bool contact_lanes) {
+RunBits compressed(int threads, int dim_steps, int lane_width) {
   PackingSpec spec;
   spec.count = 2500;
   spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
@@ -76,7 +76,7 @@ RunBits compressed(int threads, int dim_steps, bool contact_lanes) {
   cfg.contact_law = "hertz";
   cfg.local_damping = 0.2;
   cfg.threads = threads;
-  cfg.contact_lanes = contact_lanes;
+  cfg.contact_lane_width = lane_width;
   cfg.gravity = {0, 0, -9.81};
   Simulation<3> sim(testing::table(testing::hertzMaterial(5e8, 0.25, 0.5, 0.1)), cfg);
   for (std::size_t i = 0; i < p.centers.size(); ++i) {
@@ -99,17 +99,20 @@ TEST(Determinism, CompressionIsTheSameOnOneAndTwoThreads) {
     team = omp_get_num_threads();
   }
   ASSERT_EQ(team, 2);
-  EXPECT_EQ(compressed(1, 3000, true), compressed(2, 3000, true));
+  EXPECT_EQ(compressed(1, 3000, 8), compressed(2, 3000, 8));
 }
 
-// The contact pass four pairs per AVX register (contact_lanes.hpp) gives the scalar pass's
-// bits: Hertz spheres squeezed by the walls under gravity, damped, some contacts sliding and
-// some sticking, on one and two threads (the threaded pass interleaves the lanes with the
-// pairs other threads computed).
+// The contact pass four pairs per AVX register and eight per AVX-512 register
+// (contact_lanes.hpp) gives the scalar pass's bits: Hertz spheres squeezed by the walls under
+// gravity, damped, some contacts sliding and some sticking, on one and two threads (the
+// threaded pass interleaves the lanes with the pairs other threads computed). Where the CPU
+// lacks AVX-512 the width 8 runs four lanes, and the comparison repeats the four-lane one.
 TEST(Determinism, HertzContactsInLanesAreTheScalarBits) {
-  const RunBits scalar = compressed(1, 3000, false);
-  EXPECT_EQ(compressed(1, 3000, true), scalar);
-  EXPECT_EQ(compressed(2, 3000, true), scalar);
+  const RunBits scalar = compressed(1, 3000, 0);
+  for (int width : {4, 8}) {
+    EXPECT_EQ(compressed(1, 3000, width), scalar) << width << " lanes";
+    EXPECT_EQ(compressed(2, 3000, width), scalar) << width << " lanes";
+  }
   EXPECT_GT(scalar.friction, 0.0);  // contacts slid
   EXPECT_GT(scalar.viscous, 0.0);
 }
@@ -130,8 +133,8 @@ TEST(Determinism, BondBreaksAreTheSameOnOneAndTwoThreadsAndInLanes) {
     SimulationConfig cfg;
     cfg.local_damping = 0.2;
     cfg.threads = threads;
-    cfg.bond_lanes = lanes;
-    cfg.contact_lanes = lanes;
+    cfg.bond_lane_width = lanes ? 8 : 0;
+    cfg.contact_lane_width = lanes ? 8 : 0;
     Material m = testing::linearMaterial(0.0, 0.0, 0.5, 0.05);
     m.modulus = 1e8;
     Simulation<3> sim(testing::table(m), cfg);
@@ -161,7 +164,7 @@ TEST(Determinism, BondBreaksAreTheSameOnOneAndTwoThreadsAndInLanes) {
 
 // Damped linear disks squeezed by the walls, with and without the energy bookkeeping (two
 // instances of each pass), one and two threads, the contacts in lanes or one at a time.
-RunBits squeezedDisks(int threads, bool contact_lanes, bool track_energy) {
+RunBits squeezedDisks(int threads, int lane_width, bool track_energy) {
   PackingSpec spec;
   spec.count = 4000;
   spec.sizes = SizeDistribution::normal(2e-3, 0.4e-3, 1e-3, 3e-3);
@@ -171,7 +174,7 @@ RunBits squeezedDisks(int threads, bool contact_lanes, bool track_energy) {
   SimulationConfig cfg;
   cfg.local_damping = 0.1;
   cfg.threads = threads;
-  cfg.contact_lanes = contact_lanes;
+  cfg.contact_lane_width = lane_width;
   cfg.track_energy = track_energy;
   Simulation<2> sim(testing::table(testing::linearMaterial(1e7, 5e6, 0.5, 0.1)), cfg);
   for (std::size_t i = 0; i < p.centers.size(); ++i) {
@@ -184,12 +187,14 @@ RunBits squeezedDisks(int threads, bool contact_lanes, bool track_energy) {
 }
 
 TEST(Determinism, DisksInLanesAreTheScalarBitsOnOneAndTwoThreads) {
-  const RunBits scalar = squeezedDisks(1, false, true);
-  EXPECT_EQ(squeezedDisks(1, true, true), scalar);
-  EXPECT_EQ(squeezedDisks(2, true, true), scalar);
+  const RunBits scalar = squeezedDisks(1, 0, true);
+  for (int width : {4, 8}) {
+    EXPECT_EQ(squeezedDisks(1, width, true), scalar) << width << " lanes";
+    EXPECT_EQ(squeezedDisks(2, width, true), scalar) << width << " lanes";
+  }
   EXPECT_GT(scalar.friction, 0.0);
   EXPECT_GT(scalar.viscous, 0.0);
-  EXPECT_EQ(squeezedDisks(2, true, false).hash, squeezedDisks(1, false, false).hash);
+  EXPECT_EQ(squeezedDisks(2, 8, false).hash, squeezedDisks(1, 0, false).hash);
 }
 
 }  // namespace
