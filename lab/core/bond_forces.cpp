@@ -229,12 +229,15 @@ void BondForces<D>::compute(BondPass<D>& pass) {
     }
   };
 
-  // W parallel bonds at a time (Lanes: lanes::avx or lanes::avx512). Each group is settled
-  // after the next one is computed: its results are ready by then, and its scalar scatter
-  // overlaps the tail of the next group's chain. A flat joint among the next W goes alone,
-  // on the scalar path. Returns the first bond left (the block's last few).
-  const auto inLanes = [&]<class Settled, class Compute>(std::size_t blk, std::size_t b,
-                                                         std::size_t end, Compute&& compute) {
+  // W parallel bonds at a time (lanes::avx or lanes::avx512). Each group is settled after
+  // the next one is computed: its results are ready by then, and its scalar scatter overlaps
+  // the tail of the next group's chain. W flat joints of one kind (3D) go through the lanes
+  // of their own, and are recorded and applied at once, in bond order; a group of other mixes
+  // goes a bond at a time on the scalar path. Returns the first bond left (the block's last
+  // few).
+  const auto inLanes = [&]<class Settled, class Joints, class Compute, class ComputeJoints>(
+                           std::size_t blk, std::size_t b, std::size_t end, Compute&& compute,
+                           ComputeJoints&& computeJoints) {
     constexpr int W = sizeof(Settled::tensile) / sizeof(double);
     Settled s[2];
     int slot = 0;
@@ -255,39 +258,86 @@ void BondForces<D>::compute(BondPass<D>& pass) {
       if (pending != end) settleGroup(pending, s[slot ^ 1]);
       pending = end;
     };
+    // W flat joints of one kind: the joints' lanes where the dimension has them.
+    auto jointsOfOneKind = [&](std::size_t first) {
+      if (B.face[first].empty()) return false;
+      for (int k = 1; k < W; ++k) {
+        if (B.face[first + k].empty() || B.kind[first + k] != B.kind[first]) return false;
+      }
+      return true;
+    };
+    Joints joints;
     while (b + W <= end) {
       bool plain = true;
       for (int k = 0; k < W; ++k) plain &= B.face[b + k].empty();
-      if (!plain) {
-        flush();  // in bond order: the breaks of a block stay sorted
-        scalar(blk, b++);
+      if (plain) {
+        compute(b, s[slot]);
+        if (pending != end) settleGroup(pending, s[slot ^ 1]);
+        pending = b;
+        slot ^= 1;
+        b += W;
         continue;
       }
-      compute(b, s[slot]);
-      if (pending != end) settleGroup(pending, s[slot ^ 1]);
-      pending = b;
-      slot ^= 1;
-      b += W;
+      flush();  // in bond order: the breaks of a block stay sorted
+      if constexpr (D == 3) {
+        if (jointsOfOneKind(b)) {
+          computeJoints(b, joints);
+          BlockOut& out = block_[blk];
+          for (int k = 0; k < W; ++k) {
+            for (const ElementBreak<3>& e : joints.breaks[k]) {
+              out.breaks.push_back({static_cast<std::uint32_t>(b + k),
+                                    e.tensile ? BondBreakMode::Tensile : BondBreakMode::Shear,
+                                    e.stress, e.energy, e.offset, false});
+            }
+            joints.breaks[k].clear();
+            out.slip_energy += joints.slip_energy[k];
+            if ((joints.released >> k) & 1) {
+              out.released.push_back(static_cast<std::uint32_t>(b + k));
+            }
+            apply(b + k, Vec<3>(joints.force[0][k], joints.force[1][k], joints.force[2][k]),
+                  Ang<3>(joints.ti[0][k], joints.ti[1][k], joints.ti[2][k]),
+                  Ang<3>(joints.tj[0][k], joints.tj[1][k], joints.tj[2][k]));
+          }
+          b += W;
+          continue;
+        }
+      }
+      scalar(blk, b++);
     }
     flush();
     return b;
   };
   const int width = bondLaneWidth(pass.lane_width);
-  using Settled8 = std::conditional_t<D == 3, lanes::avx512::Settled, lanes::avx512::Settled2>;
-  using Settled4 = std::conditional_t<D == 3, lanes::avx::Settled, lanes::avx::Settled2>;
+  const bool breakable = pass.breakable;
+  // W joints of one kind through a width's kernel (3D).
+  const auto jointLanes = [&]<class Joints>(std::size_t first, Joints& out, auto&& kernel) {
+    if constexpr (D == 3) {
+      const std::uint8_t kind = B.kind[first];
+      kernel(P, B, first, dt, layouts_[kind], tan_friction_[kind], joint_friction_[kind], breakable,
+             out);
+    }
+  };
 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(pass.threads) if (pass.threaded)
   for (std::size_t blk = 0; blk < blocks; ++blk) {
     const std::size_t end = std::min(nb, (blk + 1) * kBlockRows);
     std::size_t b = blk * kBlockRows;
     if (width == 8) {
-      b = inLanes.template operator()<Settled8>(blk, b, end, [&](std::size_t first, Settled8& s) {
-        lanes::avx512::bonds(P, B, first, dt, s);
-      });
+      namespace l = lanes::avx512;
+      using Settled = std::conditional_t<D == 3, l::Settled, l::Settled2>;
+      b = inLanes.template operator()<Settled, l::Joints>(
+          blk, b, end, [&](std::size_t first, Settled& s) { l::bonds(P, B, first, dt, s); },
+          [&](std::size_t first, l::Joints& j) {
+            jointLanes(first, j, [](auto&&... a) { l::joints(a...); });
+          });
     } else if (width == 4) {
-      b = inLanes.template operator()<Settled4>(blk, b, end, [&](std::size_t first, Settled4& s) {
-        lanes::avx::bonds(P, B, first, dt, s);
-      });
+      namespace l = lanes::avx;
+      using Settled = std::conditional_t<D == 3, l::Settled, l::Settled2>;
+      b = inLanes.template operator()<Settled, l::Joints>(
+          blk, b, end, [&](std::size_t first, Settled& s) { l::bonds(P, B, first, dt, s); },
+          [&](std::size_t first, l::Joints& j) {
+            jointLanes(first, j, [](auto&&... a) { l::joints(a...); });
+          });
     }
     for (; b < end; ++b) scalar(blk, b);  // no lanes, or the block's last few bonds
   }

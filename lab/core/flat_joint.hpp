@@ -217,6 +217,29 @@ inline Frame<D> frameOf(const Vec<D>& n, const Vec<D>& axis) {
   }
 }
 
+// Bonded element k breaks at its centroid's stress sigma (Pa, compression positive) and
+// shear strength `strength` (Pa), having reached the tensile strength, the shear strength or
+// both: its moments go, its shear force is capped at friction, and the break is recorded
+// with the elastic energy the element gave up. The larger ratio of stress to strength names
+// the mode when both are reached.
+template <int D>
+inline void breakElement(FaceElement<D>& e, std::size_t k, const Placed& p, const FaceMaterial& m,
+                         const Frame<D>& frame, const Vec<D>& n, double sigma, double strength,
+                         bool in_tension, bool in_shear, std::vector<ElementBreak<D>>& breaks) {
+  const double tau = e.fs.norm() / p.area;
+  const double rt = -sigma / m.tensile;
+  const double rs = strength > 0.0 ? tau / strength : HUGE_VAL;
+  const bool tensile = in_tension && (!in_shear || rt >= rs);
+  const double before = energy<D>(e, p, m);
+  e.bonded = 0;
+  e.bend = Vec<2>::Zero();
+  e.twist = 0.0;
+  const double limit = m.friction * m.kn * p.area * std::max(e.approach, 0.0);
+  if (e.fs.norm() > limit) e.fs *= limit > 0.0 ? limit / e.fs.norm() : 0.0;
+  breaks.push_back({static_cast<std::uint16_t>(k), frame.world(p.x, p.y, 0.0, n), tensile,
+                    tensile ? -sigma : tau, before - energy<D>(e, p, m)});
+}
+
 }  // namespace face
 
 // One step of a flat joint: turns the face's axis with the bond, moves every element's
@@ -281,19 +304,7 @@ FaceResult<D> flatJointStep(const FaceLayout& layout, const FaceMaterial& m, con
       const bool in_tension = -sigma >= m.tensile;
       const bool in_shear = e.fs.squaredNorm() >= strength_force * strength_force;
       if (m.breakable && (in_tension || in_shear)) {
-        const double tau = e.fs.norm() / p.area;
-        // The larger ratio of stress to strength names the mode when both are reached.
-        const double rt = -sigma / m.tensile;
-        const double rs = strength > 0.0 ? tau / strength : HUGE_VAL;
-        const bool tensile = in_tension && (!in_shear || rt >= rs);
-        const double before = face::energy<D>(e, p, m);
-        e.bonded = 0;
-        e.bend = Vec<2>::Zero();
-        e.twist = 0.0;
-        const double limit = m.friction * m.kn * p.area * std::max(e.approach, 0.0);
-        if (e.fs.norm() > limit) e.fs *= limit > 0.0 ? limit / e.fs.norm() : 0.0;
-        breaks.push_back({static_cast<std::uint16_t>(k), frame.world(p.x, p.y, 0.0, n), tensile,
-                          tensile ? -sigma : tau, before - face::energy<D>(e, p, m)});
+        face::breakElement<D>(e, k, p, m, frame, n, sigma, strength, in_tension, in_shear, breaks);
       }
     } else {
       // Coulomb: the work of the capped force along the slip (relative displacement minus

@@ -96,6 +96,21 @@ inline Mask equal(L a, L b) {  // a == b
 inline Mask notEqual(L a, L b) {  // a != b, true on NaN as in C++
   return _mm256_cmp_pd(a.v, b.v, _CMP_NEQ_UQ);
 }
+inline Mask greaterEqual(L a, L b) {  // a >= b
+  return _mm256_cmp_pd(a.v, b.v, _CMP_GE_OQ);
+}
+inline Mask lessEqual(L a, L b) {  // a <= b
+  return _mm256_cmp_pd(a.v, b.v, _CMP_LE_OQ);
+}
+inline Mask andMask(Mask a, Mask b) {
+  return _mm256_and_pd(a, b);
+}
+inline Mask orMask(Mask a, Mask b) {
+  return _mm256_or_pd(a, b);
+}
+inline Mask andNotMask(Mask a, Mask b) {  // a and not b
+  return _mm256_andnot_pd(b, a);
+}
 inline int bits(Mask m) {  // bit k: lane k
   return _mm256_movemask_pd(m);
 }
@@ -198,6 +213,21 @@ inline Mask equal(L a, L b) {
 }
 inline Mask notEqual(L a, L b) {
   return _mm512_cmp_pd_mask(a.v, b.v, _CMP_NEQ_UQ);
+}
+inline Mask greaterEqual(L a, L b) {
+  return _mm512_cmp_pd_mask(a.v, b.v, _CMP_GE_OQ);
+}
+inline Mask lessEqual(L a, L b) {
+  return _mm512_cmp_pd_mask(a.v, b.v, _CMP_LE_OQ);
+}
+inline Mask andMask(Mask a, Mask b) {
+  return a & b;
+}
+inline Mask orMask(Mask a, Mask b) {
+  return a | b;
+}
+inline Mask andNotMask(Mask a, Mask b) {
+  return a & static_cast<Mask>(~b);
 }
 inline int bits(Mask m) {
   return m;
