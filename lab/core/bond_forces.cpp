@@ -309,36 +309,27 @@ void BondForces<D>::compute(BondPass<D>& pass) {
   };
   const int width = bondLaneWidth(pass.lane_width);
   const bool breakable = pass.breakable;
-  // W joints of one kind through a width's kernel (3D).
-  const auto jointLanes = [&]<class Joints>(std::size_t first, Joints& out, auto&& kernel) {
-    if constexpr (D == 3) {
-      const std::uint8_t kind = B.kind[first];
-      kernel(P, B, first, dt, layouts_[kind], tan_friction_[kind], joint_friction_[kind], breakable,
-             out);
-    }
+  // Bonds [b, end) of block blk through the lanes of one width (K: its Kernels).
+  const auto byWidth = [&]<class K>(std::size_t blk, std::size_t b, std::size_t end) {
+    using Settled = std::conditional_t<D == 3, typename K::Settled3, typename K::Settled2D>;
+    using Joints = typename K::JointsOut;
+    return inLanes.template operator()<Settled, Joints>(
+        blk, b, end, [&](std::size_t first, Settled& s) { K::parallel(P, B, first, dt, s); },
+        [&](std::size_t first, Joints& j) {
+          if constexpr (D == 3) {
+            const std::uint8_t kind = B.kind[first];
+            K::flatJoints(P, B, first, dt, layouts_[kind], tan_friction_[kind],
+                          joint_friction_[kind], breakable, j);
+          }
+        });
   };
 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(pass.threads) if (pass.threaded)
   for (std::size_t blk = 0; blk < blocks; ++blk) {
     const std::size_t end = std::min(nb, (blk + 1) * kBlockRows);
     std::size_t b = blk * kBlockRows;
-    if (width == 8) {
-      namespace l = lanes::avx512;
-      using Settled = std::conditional_t<D == 3, l::Settled, l::Settled2>;
-      b = inLanes.template operator()<Settled, l::Joints>(
-          blk, b, end, [&](std::size_t first, Settled& s) { l::bonds(P, B, first, dt, s); },
-          [&](std::size_t first, l::Joints& j) {
-            jointLanes(first, j, [](auto&&... a) { l::joints(a...); });
-          });
-    } else if (width == 4) {
-      namespace l = lanes::avx;
-      using Settled = std::conditional_t<D == 3, l::Settled, l::Settled2>;
-      b = inLanes.template operator()<Settled, l::Joints>(
-          blk, b, end, [&](std::size_t first, Settled& s) { l::bonds(P, B, first, dt, s); },
-          [&](std::size_t first, l::Joints& j) {
-            jointLanes(first, j, [](auto&&... a) { l::joints(a...); });
-          });
-    }
+    if (width == 8) b = byWidth.template operator()<lanes::avx512::Kernels>(blk, b, end);
+    if (width == 4) b = byWidth.template operator()<lanes::avx::Kernels>(blk, b, end);
     for (; b < end; ++b) scalar(blk, b);  // no lanes, or the block's last few bonds
   }
 

@@ -14,6 +14,8 @@
 
 #include <cstdint>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include "lab/core/bonds.hpp"
 #include "lab/core/lanes.hpp"
