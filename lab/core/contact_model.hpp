@@ -58,13 +58,6 @@ struct KeptContact {
   bool touching = false;
 };
 
-// A block's touching pairs in pair order, for the lane passes: rows, partners (kCross for a
-// pair another thread computed) and pair slots.
-inline constexpr std::uint32_t kCross = 0xffffffffu;
-struct TouchList {
-  std::vector<std::uint32_t> i, j, p;
-};
-
 // Work space of the force loops, kept between steps to avoid reallocating.
 template <int D>
 struct PairBuffers {
@@ -78,7 +71,6 @@ struct PairBuffers {
   std::vector<double> block_friction, block_viscous, block_cost;
   std::vector<std::uint32_t> block_touching;  // touching pairs per block, last threaded step
   std::vector<std::uint8_t> block_over, thread_over;
-  std::vector<TouchList> touch_lists;  // per thread
 };
 
 template <int D>

@@ -189,78 +189,6 @@ class ContactModelImpl final : public ContactModel<D> {
     }
   }
 
-  // The lane passes take a block of rows in two phases. First its touching pairs, in pair
-  // order, into a list (touchingPairs); then the list, `width` pairs at a time
-  // (applyTouching). The first phase is a short loop over the candidates that keeps its
-  // variables in registers and branches on nothing; interleaved with the lanes, the same
-  // test was a fifth slower per candidate (its variables spilled around the calls).
-  //
-  // Rows [r0, r1): every candidate's entry is written in turn and the list grows by one
-  // where the pair touches (by the scalar path's test, so both paths take the same pairs) or
-  // is a cross pair (partner at or past `cross_from`: computed apart by the threaded pass,
-  // and entered with j = kCross to be applied in its place). A pair out of reach loses its
-  // history. Returns the list's length.
-  static std::size_t touchingPairs(const PairView& v, const std::uint32_t* row, std::size_t r0,
-                                   std::size_t r1, std::size_t cross_from, TouchList& list) {
-    const std::size_t candidates = row[r1] - row[r0];
-    if (list.i.size() < candidates) {
-      list.i.resize(candidates);
-      list.j.resize(candidates);
-      list.p.resize(candidates);
-    }
-    std::uint32_t* li = list.i.data();
-    std::uint32_t* lj = list.j.data();
-    std::uint32_t* lp = list.p.data();
-    std::size_t m = 0;
-    for (std::size_t i = r0; i < r1; ++i) {
-      const V x = v.pos[i];
-      const double r = v.radius[i];
-      for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-        const std::uint32_t j = v.col[p];
-        const V d = v.pos[j] - x;
-        const double reach = r + v.radius[j];
-        const bool cross = j >= cross_from;
-        const bool keep = !(d.squaredNorm() >= reach * reach) || cross;
-        keepOnly(v.shear[p], keep);
-        li[m] = static_cast<std::uint32_t>(i);
-        lj[m] = cross ? kCross : j;
-        lp[m] = p;
-        m += keep;
-      }
-    }
-    return m;
-  }
-
-  // The list's first m pairs applied in order, `width` at a time; a cross pair's entry hands
-  // its row to crossPair(i, diss) after the pairs before it. Returns the touching pairs
-  // (cross pairs apart).
-  template <bool kEnergy, class CrossPair>
-  std::uint32_t applyTouching(const PairView& v, const TouchList& list, std::size_t m, int width,
-                              ContactDissipation& diss, bool& over, V* force, A* torque,
-                              CrossPair&& crossPair) const {
-    const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti, const A& tj) {
-      scatter(force, torque, i, j, f, ti, tj);
-    };
-    LaneGroup g;
-    std::uint32_t touching = 0;
-    for (std::size_t e = 0; e < m; ++e) {
-      const std::uint32_t i = list.i[e], j = list.j[e];
-      if (j == kCross) {  // the pending pairs come first in pair order
-        flush<kEnergy>(v, g, width, diss, over, apply);
-        crossPair(i, diss);
-        continue;
-      }
-      ++touching;
-      g.is[g.n] = i;
-      g.js[g.n] = j;
-      g.ps[g.n] = list.p[e];
-      g.params[g.n] = &table_(v.material[i], v.material[j]);
-      if (++g.n == width) flush<kEnergy>(v, g, width, diss, over, apply);
-    }
-    flush<kEnergy>(v, g, width, diss, over, apply);
-    return touching;
-  }
-
   // The group's pairs in `width` lanes, then each applied in order, with its dissipation, as
   // interact() would have (a short group repeats its first pair in the empty lanes). Only
   // called where laneWidth() is not 0.
@@ -355,16 +283,22 @@ class ContactModelImpl final : public ContactModel<D> {
     A* torque = P.torque.data();
     const int width = laneWidth(pass);
     const bool lanes_on = width > 0;
-    buffers_.touch_lists.resize(1);
     for (std::size_t b = 0; b < blocks; ++b) {
       ContactDissipation diss;
       bool over = false;  // not a uint8_t: a char store may alias anything
       const std::size_t i_end = std::min(n, (b + 1) * kBlockRows);
       if (lanes_on) {
-        TouchList& list = buffers_.touch_lists[0];
-        const std::size_t m = touchingPairs(v, row, b * kBlockRows, i_end, n, list);
-        applyTouching<kEnergy>(v, list, m, width, diss, over, force, torque,
-                               [](std::uint32_t, ContactDissipation&) {});
+        LaneGroup g;
+        const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti,
+                               const A& tj) { scatter(force, torque, i, j, f, ti, tj); };
+        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
+          const RowParticle a = rowParticle(v, i);
+          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+            collect(g, v, a, i, p, v.col[p]);
+            if (g.n == width) flush<kEnergy>(v, g, width, diss, over, apply);
+          }
+        }
+        flush<kEnergy>(v, g, width, diss, over, apply);
       } else {
         for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
           const RowParticle a = rowParticle(v, i);
@@ -420,7 +354,6 @@ class ContactModelImpl final : public ContactModel<D> {
     B.own_cross_row.resize(threads);
     B.cross_start.assign(threads + 1, 0);
     B.thread_over.assign(threads, 0);
-    B.touch_lists.resize(threads);
     const PairView v = viewOf(pass);
     V* force = P.force.data();
     A* torque = P.torque.data();
@@ -532,27 +465,31 @@ class ContactModelImpl final : public ContactModel<D> {
           torque[i] -= kept.f.torque_i;
         };
         const std::size_t i_end = std::min(hi, (b + 1) * kBlockRows);
-        if (lanes_on) {
-          TouchList& list = B.touch_lists[t];
-          const std::size_t m = touchingPairs(v, row, b * kBlockRows, i_end, hi, list);
-          touching =
-              applyTouching<kEnergy>(v, list, m, width, diss, over, force, torque, crossPair);
-        } else {
-          for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
-            const RowParticle a = rowParticle(v, i);
-            for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-              const std::uint32_t j = col[p];
-              if (j >= hi) {
-                crossPair(i, diss);
-                continue;
-              }
-              touching += interact<kEnergy>(
-                  v, a, p, diss, over, [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
-                    scatter(force, torque, i, j, f, ti, tj);
-                  });
+        LaneGroup group;
+        const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti,
+                               const A& tj) { scatter(force, torque, i, j, f, ti, tj); };
+        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
+          const RowParticle a = rowParticle(v, i);
+          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+            const std::uint32_t j = col[p];
+            if (j >= hi) {
+              // The pending pairs come first in pair order: theirs before this one's share.
+              if (lanes_on) flush<kEnergy>(v, group, width, diss, over, apply);
+              crossPair(i, diss);
+              continue;
             }
+            if (lanes_on) {
+              touching += collect(group, v, a, i, p, j);
+              if (group.n == width) flush<kEnergy>(v, group, width, diss, over, apply);
+              continue;
+            }
+            touching += interact<kEnergy>(v, a, p, diss, over,
+                                          [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
+                                            scatter(force, torque, i, j, f, ti, tj);
+                                          });
           }
         }
+        if (lanes_on) flush<kEnergy>(v, group, width, diss, over, apply);
         storeBlock(b, diss, over);
         B.block_touching[b] = touching;
       }
