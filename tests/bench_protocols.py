@@ -13,7 +13,7 @@ source tree) when given: a protocol whose defaults moved to new keys runs as it 
 is what a user of the old binary waited for. Printed per protocol: the median wall time
 of each binary (the process's, what a user waits for), their ratio old / new, and each key
 result of the new binary's last run against the seed scatter of the protocol's regression
-reference (tests/reference/<protocol>.toml holds its values at three seeds): inside when it
+reference (tests/reference/<protocol>.toml holds its values at eight seeds): inside when it
 lies in the 95% prediction interval of one more seed, mean +- t(0.975, n - 1) s sqrt(1 + 1/n).
 A result the reference does not guard is listed as such. With --stages PREFIX, also the
 median seconds of each stage timing of the notebook whose name starts with PREFIX (for
@@ -90,9 +90,9 @@ def key_results(binary, lab):
 
 def scatter_verdict(name, value, reference):
     entry = reference.get(name)
-    if entry is None or "seeds" not in entry:
+    if entry is None or "values" not in entry:
         return "not guarded by the reference"
-    seeds = entry["seeds"]
+    seeds = entry["values"]
     n = len(seeds)
     if value is None:
         return "not recorded"
@@ -115,7 +115,7 @@ def reference_of(protocol_name):
 
     def walk(table, prefix):
         for key, v in table.items():
-            if isinstance(v, dict) and "value" not in v:
+            if isinstance(v, dict) and "values" not in v:
                 walk(v, prefix + key + ".")
             else:
                 flat[prefix + key] = v

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 namespace rocklab::campaign {
@@ -52,16 +53,21 @@ double studentCdf(double t, double df) {
 
 }  // namespace
 
-double studentT975(double df) {
+double studentT(double p, double df) {
   if (!(df >= 1.0)) throw std::invalid_argument("Student's t needs at least one degree of freedom");
-  const double nu = df;
-  // Bisection on the CDF: it rises monotonically; t(0.975) lies in [1.9, 12.8] for df >= 1.
-  double lo = 1.9, hi = 12.8;
-  for (int k = 0; k < 200 && hi - lo > 1e-13; ++k) {
+  if (!(p >= 0.5 && p < 1.0)) throw std::invalid_argument("a quantile in [0.5, 1) of Student's t");
+  // Bisection on the CDF: it rises monotonically, and t(p) of one degree of freedom,
+  // tan(pi (p - 1/2)), bounds the others'.
+  double lo = 0.0, hi = std::tan(std::numbers::pi * (p - 0.5)) + 1.0;
+  for (int k = 0; k < 400 && hi - lo > 1e-13 * hi; ++k) {
     const double mid = 0.5 * (lo + hi);
-    (studentCdf(mid, nu) < 0.975 ? lo : hi) = mid;
+    (studentCdf(mid, df) < p ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
+}
+
+double studentT975(double df) {
+  return studentT(0.975, df);
 }
 
 Summary summarize(const std::vector<double>& values) {

@@ -7,8 +7,10 @@
 
 namespace rocklab::campaign {
 
-// The 97.5% quantile of Student's t distribution with `df` degrees of freedom (df >= 1, not
-// necessarily whole: Welch's are not): the half-width factor of a two-sided 95% interval.
+// The p quantile (0.5 <= p < 1) of Student's t distribution with `df` degrees of freedom
+// (df >= 1, not necessarily whole: Welch's are not).
+double studentT(double p, double df);
+// Its 97.5% quantile: the half-width factor of a two-sided 95% interval.
 double studentT975(double df);
 
 struct Summary {

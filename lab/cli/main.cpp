@@ -11,6 +11,7 @@
 #include "lab/cli/calibrate_commands.hpp"
 #include "lab/cli/campaign_commands.hpp"
 #include "lab/cli/lab_commands.hpp"
+#include "lab/cli/regress_commands.hpp"
 #include "lab/cli/study_commands.hpp"
 #include "lab/core/contact_laws.hpp"
 #include "lab/core/packing_io.hpp"
@@ -430,25 +431,30 @@ void addRegress(CLI::App& app, Action& action) {
   auto* rg = app.add_subcommand(
       "regress", "Key results against reference files (the regression guard), and regenerate them");
   rg->require_subcommand(1);
-  auto* rgc = rg->add_subcommand("check", "Compare a run's key results with a reference file");
+  auto* rgc = rg->add_subcommand(
+      "check", "Compare the key results of the runs at the reference's seeds with the reference");
   rgc->add_option("reference", c->reference, "Reference file (tests/reference/NAME.toml)")
       ->required();
   rgc->add_option("--lab", c->lab, "Lab notebook (SQLite)");
-  rgc->add_option("--run", c->run, "Run id (default: the newest run of the protocol)");
+  rgc->add_option("--run", c->run,
+                  "One run (default: the newest run of the protocol at each of the reference's "
+                  "seeds)");
   rgc->callback([&action, c] {
     action = [c] { return rocklab::cli::regressCheck(c->reference, c->lab, c->run); };
   });
   auto u = std::make_shared<rocklab::cli::RegressUpdateOptions>();
   auto* rgu = rg->add_subcommand(
       "update",
-      "Run protocols at several seeds and write their reference files: the value at the "
-      "protocol's seed, the tolerance from the seeds' spread");
+      "Run protocols at several seeds from their own and write their reference files: each key "
+      "result's values at the seeds, their mean and standard deviation");
   rgu->add_option("protocols", u->protocols, "Protocol files")
       ->required()
       ->check(CLI::ExistingFile);
   rgu->add_option("--out", u->out, "Folder of the reference files");
   rgu->add_option("--lab", u->lab, "Lab notebook the runs go to");
-  rgu->add_option("--seeds", u->seeds, "Seeds per protocol")->check(CLI::Range(2, 100));
+  rgu->add_option("--seeds", u->seeds,
+                  "Seeds per protocol, from its own (the check's interval narrows with them)")
+      ->check(CLI::Range(2, 100));
   rgu->add_option("--threads", u->threads, "Threads of every run")->check(CLI::Range(1, 1024));
   rgu->callback([&action, u] { action = [u] { return rocklab::cli::regressUpdate(*u); }; });
 }

@@ -1,7 +1,6 @@
 #pragma once
 // `rocklab study accuracy`: a protocol over a ladder of numerical settings, and what its key
-// results lose against the time saved. `rocklab regress`: the quick protocols' key results
-// against reference files, and the explicit command that regenerates those.
+// results lose against the time saved.
 
 #include <cstdint>
 #include <string>
@@ -28,20 +27,5 @@ int studyAccuracy(const StudyOptions& o);
 // Writes the report of a study from its runs in the notebook (the first is the finest).
 int studyReport(const std::vector<std::int64_t>& runs, const std::string& lab,
                 const std::string& out, double tolerance_percent);
-
-// Compares a run's key results with a reference file; 0 within tolerance, 1 not, 2 bad input.
-// run 0: the newest run of the reference's protocol in the notebook.
-int regressCheck(const std::string& reference, const std::string& lab, std::int64_t run);
-
-struct RegressUpdateOptions {
-  std::vector<std::string> protocols;
-  std::string out = "tests/reference";
-  std::string lab = "lab.sqlite";
-  int seeds = 3;
-  int threads = 0;
-};
-// Runs each protocol at `seeds` seeds (its own and the next ones) and writes
-// out/<protocol name>.toml: the value at its own seed and a tolerance from the seeds' spread.
-int regressUpdate(const RegressUpdateOptions& o);
 
 }  // namespace rocklab::cli

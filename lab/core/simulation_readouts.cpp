@@ -20,7 +20,7 @@ void Simulation<D>::guard(bool overlap_exceeded) {
   if (overlap_exceeded) {
     std::ostringstream s;
     s << "an overlap exceeded " << config_.guard.overlap_limit
-      << " of the smaller radius (guard.overlap_limit)";
+      << " of the smaller radius (numerics.overlap_limit)";
     fail(SimulationUnstable::Cause::Overlap, s.str());
   }
   // Kinetic energy cannot exceed what the sample held plus what was put in; a few times
@@ -81,7 +81,7 @@ std::string Simulation<D>::diagnose() const {
   }
   if (causes == 0) {
     s << "No single cause stands out: check the stiffness contrast between materials, the "
-         "loading rate and guard.overlap_limit.\n";
+         "loading rate and numerics.overlap_limit.\n";
   }
   // The deepest contact as it stands: where to look, and how fast it closed.
   Touching deepest;
@@ -109,7 +109,7 @@ std::string Simulation<D>::diagnose() const {
     // limit, not the integration's.
     if (ratio >= config_.guard.overlap_limit && std::abs(per_step) < 1e-4) {
       s << "It closed slowly: a static load too high for the contact stiffness, not an "
-           "instability. Stiffen the contacts, or raise guard.overlap_limit if an overlap this "
+           "instability. Stiffen the contacts, or raise numerics.overlap_limit if an overlap this "
            "deep is acceptable for the smallest particles.\n";
     }
   }

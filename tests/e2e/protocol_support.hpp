@@ -56,9 +56,9 @@ inline std::vector<double> seriesValues(nb::Notebook& n, const std::string& name
 }
 
 // Runs a quick protocol into its own notebook and returns it. Every quick protocol passes
-// here, so every one is also held to its regression reference: its key results within the
-// tolerances of tests/reference/<protocol>.toml (twice their spread over three seeds;
-// `make references` regenerates the files, for review).
+// here, so every one is also held to its regression reference at its own seed: each key
+// result within the interval one seed has about the mean of the reference's eight
+// (tests/reference/<protocol>.toml; `make references` regenerates the files, for review).
 inline nb::Notebook runQuick(const Lab& lab, const std::string& protocol) {
   std::string out;
   EXPECT_EQ(rocklab::testing::runRocklab("run " + sourceDir() + "/protocols/" + protocol +

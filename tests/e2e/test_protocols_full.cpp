@@ -3,11 +3,15 @@
 // protocols (0.94 million steps, the longest of all): the envelope sweep's tests at 4 and 18
 // MPa show their break modes, crushing and cap
 // (QuickProtocols.EnvelopeSweepGivesMohrCoulombLineAndCap); the compaction band normal to sigma_1
-// and its strain windows are shown here only.
+// and its strain windows are shown here only. And the regression guard at all of each
+// reference's seeds.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <regex>
 
 #include "tests/e2e/protocol_support.hpp"
 
@@ -68,5 +72,54 @@ TEST(QuickProtocols, HighConfinementBreaksInShearAndCrushesGrains) {
                              "stage = 'loading'")),
             result(high, "broken_grain_bonds_tensile") + result(high, "broken_grain_bonds_shear"));
 }
+
+// The regression guard at every seed of each reference (issue 30). The default run holds each
+// quick protocol at its own seed, where a key result is guarded only if one seed's interval,
+// t(0.995, 7) s sqrt(1/8 + 1), stays within 15% of the mean; a result that scatters more is
+// named there as not guarded. Here the mean of all eight seeds is held to the reference's,
+// within t(0.995, 7) s sqrt(1/8 + 1/8) = 1.75 s: results scattering up to 8.6% of their mean
+// are guarded; one that scatters more still is not, and its reference file says so. Each
+// protocol is a test of its own (--gtest_filter picks one): all of them take about as long as
+// `make references`, two hours on 2 cores.
+std::vector<std::string> referencedProtocols() {
+  std::vector<std::string> names;
+  for (const auto& f : std::filesystem::directory_iterator(sourceDir() + "/tests/reference")) {
+    if (f.path().extension() == ".toml") names.push_back(f.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+class GuardAtEverySeed : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(GuardAtEverySeed, HoldsTheMeanOfTheReferencesSeeds) {
+  const std::string protocol = GetParam();
+  const std::string reference = sourceDir() + "/tests/reference/" + protocol + ".toml";
+  std::ifstream in(reference);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(text, m, std::regex(R"(\nseeds = \[([0-9, ]+)\])"))) << reference;
+  const std::string seeds = m[1].str();
+  Lab lab("guard-" + protocol);
+  std::string out;
+  const std::regex number("[0-9]+");
+  for (std::sregex_iterator it(seeds.begin(), seeds.end(), number), end; it != end; ++it) {
+    EXPECT_EQ(runRocklab("run " + sourceDir() + "/protocols/" + protocol +
+                             ".toml --set protocol.seed=" + it->str() +
+                             " --quiet --threads 1 --lab " + lab.path,
+                         &out),
+              0)
+        << out;
+  }
+  EXPECT_EQ(runRocklab("regress check " + reference + " --lab " + lab.path, &out), 0) << out;
+  removeLabFiles(lab);
+}
+
+INSTANTIATE_TEST_SUITE_P(QuickProtocols, GuardAtEverySeed,
+                         ::testing::ValuesIn(referencedProtocols()), [](const auto& info) {
+                           std::string name = info.param;
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 
 #include "lab/campaign/campaign.hpp"
 #include "lab/campaign/statistics.hpp"
@@ -151,6 +152,13 @@ TEST(CampaignStatistics, StudentQuantilesMatchTheTables) {
   // monotonically: t(2.5) lies between t(2) and t(3).
   EXPECT_LT(studentT975(2.5), 4.3027);
   EXPECT_GT(studentT975(2.5), 3.1824);
+  // Other quantiles (the regression guard's 99.5%), from the same tables: t(0.995, df), and
+  // t(0.5) = 0; one degree of freedom is Cauchy's, tan(pi (p - 1/2)).
+  const std::pair<std::size_t, double> t995[] = {{4, 4.6041}, {7, 3.4995}, {9, 3.2498}};
+  for (const auto& [df, t] : t995) EXPECT_NEAR(studentT(0.995, df), t, 5e-5) << "df " << df;
+  EXPECT_NEAR(studentT(0.9, 1), std::tan(0.4 * std::numbers::pi), 1e-9);
+  EXPECT_NEAR(studentT(0.5, 7), 0.0, 1e-9);
+  EXPECT_THROW(studentT(1.0, 7), std::invalid_argument);
 }
 
 // Welch's interval in the two cases with a closed form: equal sizes and scatters give

@@ -1,0 +1,338 @@
+#include "lab/cli/regress_commands.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <toml.hpp>
+
+#include "lab/campaign/statistics.hpp"
+#include "lab/cli/build_info.hpp"
+#include "lab/cli/lab_commands.hpp"
+#include "reports/key_results.hpp"
+#include "reports/run_data.hpp"
+
+namespace rocklab::cli {
+
+namespace {
+
+// A check's interval: the 99.5% quantile of Student's t (a key result of an unchanged
+// physics fails one check in a hundred at most, where rounding redraws its samples).
+constexpr double kGuardQuantile = 0.995;
+// A key result whose interval is wider than this share of its mean is not guarded at the
+// seeds a check has (a physics change could hide in it); more seeds narrow it.
+constexpr double kWidestGuard = 0.15;
+// An interval at least this share of the mean: a result the seeds do not scatter (the stress
+// a servo reached) still moves by a last bit or two.
+constexpr double kNarrowestGuard = 1e-6;
+
+struct Reference {
+  std::string protocol;
+  std::vector<std::int64_t> seeds;
+  struct Key {
+    std::string name, unit;
+    std::vector<double> values;  // at each seed
+    campaign::Summary summary;   // over the seeds
+  };
+  std::vector<Key> keys;
+};
+
+// The half-width of a check of a key result at m seeds: the means over the reference's n seeds
+// and over the m checked are two draws of the sample's scatter once anything changes the
+// rounding (a reordered sum, another compiler), so their difference spreads as
+// s sqrt(1/n + 1/m), s the reference's standard deviation.
+double halfWidth(const campaign::Summary& s, std::size_t m) {
+  const double n = static_cast<double>(s.n);
+  const double half = campaign::studentT(kGuardQuantile, n - 1.0) * s.std *
+                      std::sqrt(1.0 / n + 1.0 / static_cast<double>(m));
+  return std::max(half, kNarrowestGuard * std::abs(s.mean));
+}
+
+bool guarded(const campaign::Summary& s, std::size_t m) {
+  return halfWidth(s, m) <= kWidestGuard * std::abs(s.mean);
+}
+
+Reference readReference(const std::string& path) {
+  if (!std::filesystem::exists(path)) {
+    throw std::invalid_argument(path +
+                                ": no such reference file (`rocklab regress update` "
+                                "writes them)");
+  }
+  Reference r;
+  try {
+    // Ordered by name, so that a check lists them the same way every time.
+    const auto root = toml::parse<toml::discard_comments, std::map, std::vector>(path);
+    r.protocol = toml::find<std::string>(root, "protocol");
+    if (!root.contains("seeds")) {
+      throw std::invalid_argument(
+          "no `seeds`: a reference of an older rocklab (one seed's value); write it anew with "
+          "`rocklab regress update`");
+    }
+    r.seeds = toml::find<std::vector<std::int64_t>>(root, "seeds");
+    if (r.seeds.size() < 2) throw std::invalid_argument("`seeds`: at least two");
+    // A prefixed name ("stage1.vp_z") is written quoted; unquoted, TOML reads it as nested
+    // tables, which are walked down to the entries that hold values.
+    auto walk = [&](auto&& self, const auto& table, const std::string& prefix) -> void {
+      for (const auto& [key, v] : table) {
+        if (!v.is_table()) continue;
+        if (!v.contains("values")) {
+          self(self, v.as_table(), prefix + key + ".");
+          continue;
+        }
+        Reference::Key k;
+        k.name = prefix + key;
+        k.values = toml::find<std::vector<double>>(v, "values");
+        k.unit = toml::find_or<std::string>(v, "unit", "");
+        if (k.values.size() != r.seeds.size()) {
+          throw std::invalid_argument("results." + k.name + ": " + std::to_string(k.values.size()) +
+                                      " values for " + std::to_string(r.seeds.size()) + " seeds");
+        }
+        k.summary = campaign::summarize(k.values);
+        r.keys.push_back(k);
+      }
+    };
+    walk(walk, toml::find(root, "results").as_table(), "");
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(path + ": not a reference file: " + e.what());
+  }
+  return r;
+}
+
+// A TOML float: always with a point or an exponent, so that it reads back as one.
+std::string fmt(double v, int digits = 7) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  std::ostringstream s;
+  s.precision(digits);
+  s << v;
+  std::string t = s.str();
+  if (t.find_first_of(".e") == std::string::npos) t += ".0";
+  return t;
+}
+
+// The newest run of a protocol at a seed, or 0.
+std::int64_t newestRunAt(notebook::Notebook& nb, const std::string& protocol, std::int64_t seed) {
+  auto s = nb.db().prepare("SELECT max(id) FROM runs WHERE protocol = ? AND seed = ?");
+  s.bind(1, std::string_view(protocol));
+  s.bind(2, seed);
+  return s.step() && !s.isNull(0) ? s.integer(0) : 0;
+}
+
+std::int64_t seedOf(notebook::Notebook& nb, std::int64_t run) {
+  auto s = nb.db().prepare("SELECT seed FROM runs WHERE id = ?");
+  s.bind(1, run);
+  return s.step() && !s.isNull(0) ? s.integer(0) : -1;
+}
+
+}  // namespace
+
+int regressCheck(const std::string& reference, const std::string& lab, std::int64_t run) {
+  Reference ref;
+  try {
+    ref = readReference(reference);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  }
+  if (!std::filesystem::exists(lab)) {
+    std::cerr << "no lab notebook at '" << lab << "'\n";
+    return 2;
+  }
+  notebook::Notebook nb(lab);
+  // The runs to check, each at a seed of the reference.
+  std::vector<std::pair<std::int64_t, std::int64_t>> runs;  // run, seed
+  if (run != 0) {
+    const std::int64_t seed = seedOf(nb, run);
+    if (std::find(ref.seeds.begin(), ref.seeds.end(), seed) == ref.seeds.end()) {
+      std::cerr << "run " << run << " is not at a seed of the reference\n";
+      return 2;
+    }
+    runs.emplace_back(run, seed);
+  } else {
+    for (const std::int64_t seed : ref.seeds) {
+      if (const std::int64_t id = newestRunAt(nb, ref.protocol, seed)) runs.emplace_back(id, seed);
+    }
+  }
+  if (runs.empty()) {
+    std::cerr << lab << ": no run of protocol '" << ref.protocol
+              << "' at a seed of the reference\n";
+    return 2;
+  }
+  std::vector<reports::RunData> data;
+  bool ok = true;
+  std::string seeds;
+  for (const auto& [id, seed] : runs) {
+    data.push_back(reports::loadRun(nb, id));
+    if (data.back().protocol != ref.protocol) {
+      std::cerr << "run " << id << " is of protocol '" << data.back().protocol
+                << "', the reference of '" << ref.protocol << "'\n";
+      return 2;
+    }
+    ok = ok && data.back().status == "completed";
+    seeds += (seeds.empty() ? "" : ", ") + std::to_string(seed) + " (run " + std::to_string(id) +
+             ", " + data.back().status + ")";
+  }
+  const std::size_t m = runs.size();
+  std::cout << ref.protocol << " at seed" << (m > 1 ? "s " : " ") << seeds << " against "
+            << reference << " (" << ref.seeds.size() << " seeds):\n";
+  for (const Reference::Key& key : ref.keys) {
+    std::vector<double> values;
+    for (const reports::RunData& r : data) {
+      if (const std::optional<double> v = reports::evaluateKeyResult(r, key.name)) {
+        values.push_back(*v);
+      }
+    }
+    const campaign::Summary s = key.summary;
+    const std::string unit = key.unit.empty() || key.unit == "-" ? "" : " " + key.unit;
+    const std::string shown =
+        values.size() == m ? fmt(campaign::summarize(values).mean) + unit : "not recorded";
+    if (!guarded(s, m)) {
+      std::cout << "  --   " << key.name << " = " << shown << ": not guarded at " << m << " seed"
+                << (m > 1 ? "s" : "") << " (the reference's scatter, "
+                << fmt(100.0 * s.std / std::abs(s.mean), 2) << "% of the mean, leaves +-"
+                << fmt(100.0 * halfWidth(s, m) / std::abs(s.mean), 2) << "%)\n";
+      continue;
+    }
+    const double half = halfWidth(s, m);
+    const bool within =
+        values.size() == m && std::abs(campaign::summarize(values).mean - s.mean) <= half;
+    ok = ok && within;
+    std::cout << "  " << (within ? "ok  " : "FAIL") << " " << key.name << " = " << shown
+              << ", reference " << fmt(s.mean) << " +- " << fmt(half) << unit << "\n";
+  }
+  if (!ok) {
+    std::cout << "key results moved beyond the sample's scatter: if the change is meant, "
+                 "regenerate the references (make references) and review their diff\n";
+  }
+  return ok ? 0 : 1;
+}
+
+namespace {
+
+// A protocol run at `seeds` seeds from its own; the runs' data, or fewer when one failed.
+std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const std::string& file,
+                                         const RegressUpdateOptions& o, bool& interrupted) {
+  const std::int64_t seed0 = c.settings.integer("protocol.seed");
+  std::vector<reports::RunData> runs;
+  for (int k = 0; k < o.seeds; ++k) {
+    protocol::Settings s = c.settings;
+    s.override("protocol.seed", seed0 + k);
+    if (o.threads > 0) s.runChoice("numerics.threads", static_cast<std::int64_t>(o.threads));
+    const RunOutcome r = runSettings(*c.rig, s, file, o.lab, true);
+    if (r.code == 130) interrupted = true;
+    if (r.code != 0) {
+      if (!interrupted) {
+        std::cerr << file << ": run " << r.run << " at seed " << seed0 + k
+                  << " did not complete: no reference written for it\n";
+      }
+      break;
+    }
+    notebook::Notebook nb(o.lab);
+    runs.push_back(reports::loadRun(nb, r.run));
+  }
+  return runs;
+}
+
+// The reference file of a protocol from its runs at successive seeds.
+std::string referenceFile(const rigs::CheckedProtocol& c,
+                          const std::vector<reports::RunData>& runs) {
+  const std::string name = c.settings.text("protocol.name");
+  const std::int64_t seed0 = c.settings.integer("protocol.seed");
+  const std::size_t n = runs.size();
+  std::ostringstream file;
+  file << "# Key results of " << name << " guarded by the regression test (tests/e2e).\n"
+       << "# Written by `rocklab regress update` at git " << kGitRevision
+       << "; review the diff before committing.\n"
+       << "# values: at each seed. A check at m of the seeds holds the mean of its values to "
+          "the mean of\n# these within t("
+       << kGuardQuantile << ", n - 1) s sqrt(1/n + 1/m) "
+       << "(s: their standard deviation, n their\n# count); a key result whose interval passes "
+       << 100.0 * kWidestGuard << "% of the mean is not guarded at m seeds.\n"
+       << "protocol = \"" << name << "\"\nseeds = [";
+  for (std::size_t k = 0; k < n; ++k) {
+    file << (k ? ", " : "") << seed0 + static_cast<std::int64_t>(k);
+  }
+  file << "]\n";
+  std::string notes;
+  for (const std::string& key : c.settings.texts("protocol.key_results")) {
+    std::vector<double> v;
+    for (const reports::RunData& r : runs) {
+      if (const auto x = reports::evaluateKeyResult(r, key)) v.push_back(*x);
+    }
+    // A key result some seed does not record (no band found, a pulse drowned) cannot be
+    // held to a value: it is listed, not guarded.
+    if (v.size() < n) {
+      notes += "#   " + key + ": not guarded, recorded at " + std::to_string(v.size()) + " of " +
+               std::to_string(n) + " seeds\n";
+      std::cerr << name << ": key result '" << key << "' recorded at " << v.size() << " of " << n
+                << " seeds: not guarded\n";
+      continue;
+    }
+    const campaign::Summary s = campaign::summarize(v);
+    auto percent = [&](std::size_t m) {
+      return fmt(100.0 * halfWidth(s, m) / std::abs(s.mean), 2);
+    };
+    notes += "#   " + key + ": +-" + percent(1) + "% at one seed" +
+             (guarded(s, 1) ? "" : " (not guarded)") + ", +-" + percent(n) + "% at all " +
+             std::to_string(n) + (guarded(s, n) ? "" : " (not guarded)") + "\n";
+    const std::string quoted = key.find('.') == std::string::npos ? key : "\"" + key + "\"";
+    file << "\n[results." << quoted << "]\nunit = \"" << c.rig->outputs().keyResult(key)->unit
+         << "\"\nvalues = [";
+    for (std::size_t k = 0; k < n; ++k) file << (k ? ", " : "") << fmt(v[k], 10);
+    file << "]\nmean = " << fmt(s.mean) << "\nstandard_deviation = " << fmt(s.std) << "\n";
+  }
+  file << "\n# The check's half-width, as a share of the mean:\n" << notes;
+  return file.str();
+}
+
+}  // namespace
+
+int regressUpdate(const RegressUpdateOptions& o) {
+  if (o.seeds < 2) {
+    std::cerr << "regress update: --seeds must be at least 2 (the interval is their scatter)\n";
+    return 2;
+  }
+  std::vector<rigs::CheckedProtocol> checked;
+  try {
+    for (const std::string& p : o.protocols) {
+      checked.push_back(rigs::checkProtocol(p));
+      if (checked.back().settings.texts("protocol.key_results").empty()) {
+        protocol::fail(checked.back().settings, "protocol.key_results",
+                       "the protocol names no key results: there is nothing to guard");
+      }
+    }
+  } catch (const protocol::ProtocolError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  }
+  std::filesystem::create_directories(o.out);
+  bool failed = false;
+  for (std::size_t p = 0; p < checked.size(); ++p) {
+    bool interrupted = false;
+    const auto runs = runAtSeeds(checked[p], o.protocols[p], o, interrupted);
+    if (interrupted) return 130;
+    if (runs.size() < static_cast<std::size_t>(o.seeds)) {
+      failed = true;
+      continue;
+    }
+    const std::string path = o.out + "/" + checked[p].settings.text("protocol.name") + ".toml";
+    const std::string temporary = path + ".tmp";
+    std::ofstream out(temporary);
+    out << referenceFile(checked[p], runs);
+    out.close();
+    if (!out) {
+      std::cerr << "cannot write " << temporary << "\n";
+      return 1;
+    }
+    std::filesystem::rename(temporary, path);  // a killed update leaves the old file whole
+    std::cout << "wrote " << path << "\n";
+  }
+  std::cout << "review with `git diff " << o.out << "` before committing\n";
+  return failed ? 1 : 0;
+}
+
+}  // namespace rocklab::cli
