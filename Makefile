@@ -98,7 +98,7 @@ catalogue: build
 # The regression references of the quick protocols (tests/reference, checked by the e2e tests):
 # each protocol at eight seeds, their values, mean and scatter (tests/README.md says how a check
 # holds a run to them). One protocol per process on a thread, two at a time, each into its own
-# notebook (about two hours on 2 cores).
+# notebook (about an hour and a quarter on 2 cores).
 # An explicit step: review `git diff tests/reference` before committing.
 references: build
 	@mkdir -p build/references

@@ -80,7 +80,7 @@ TEST(QuickProtocols, HighConfinementBreaksInShearAndCrushesGrains) {
 // within t(0.995, 7) s sqrt(1/8 + 1/8) = 1.75 s: results scattering up to 8.6% of their mean
 // are guarded; one that scatters more still is not, and its reference file says so. Each
 // protocol is a test of its own (--gtest_filter picks one): all of them take about as long as
-// `make references`, two hours on 2 cores.
+// `make references`, an hour and a quarter on 2 cores.
 std::vector<std::string> referencedProtocols() {
   std::vector<std::string> names;
   for (const auto& f : std::filesystem::directory_iterator(sourceDir() + "/tests/reference")) {
