@@ -271,6 +271,46 @@ class ContactModelImpl final : public ContactModel<D> {
     buffers_.block_over.assign(blocks, 0);
   }
 
+  // Rows [r0, r1) of a block in pair order, `width` pairs at a time (0: one at a time, by
+  // interact()); a pair whose partner is at or past `cross_from` was computed apart (by the
+  // threaded pass) and hands its row to crossPair(i, diss) in its place. Returns the touching
+  // pairs, cross pairs apart.
+  template <bool kEnergy, class CrossPair>
+  std::uint32_t blockRows(const PairView& v, const std::uint32_t* row, std::size_t r0,
+                          std::size_t r1, std::size_t cross_from, int width,
+                          ContactDissipation& diss, bool& over, V* force, A* torque,
+                          CrossPair&& crossPair) const {
+    const bool lanes_on = width > 0;
+    LaneGroup group;
+    const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti, const A& tj) {
+      scatter(force, torque, i, j, f, ti, tj);
+    };
+    std::uint32_t touching = 0;
+    for (std::size_t i = r0; i < r1; ++i) {
+      const RowParticle a = rowParticle(v, i);
+      for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+        const std::uint32_t j = v.col[p];
+        if (j >= cross_from) {
+          // The pending pairs come first in pair order: theirs before this one's share.
+          if (lanes_on) flush<kEnergy>(v, group, width, diss, over, apply);
+          crossPair(i, diss);
+          continue;
+        }
+        if (lanes_on) {
+          touching += collect(group, v, a, i, p, j);
+          if (group.n == width) flush<kEnergy>(v, group, width, diss, over, apply);
+          continue;
+        }
+        touching += interact<kEnergy>(v, a, p, diss, over,
+                                      [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
+                                        scatter(force, torque, i, j, f, ti, tj);
+                                      });
+      }
+    }
+    if (lanes_on) flush<kEnergy>(v, group, width, diss, over, apply);
+    return touching;
+  }
+
   template <bool kEnergy>
   void serialPairLoop(ContactPass<D>& pass) {
     auto& P = pass.particles;
@@ -282,34 +322,11 @@ class ContactModelImpl final : public ContactModel<D> {
     V* force = P.force.data();
     A* torque = P.torque.data();
     const int width = laneWidth(pass);
-    const bool lanes_on = width > 0;
     for (std::size_t b = 0; b < blocks; ++b) {
       ContactDissipation diss;
       bool over = false;  // not a uint8_t: a char store may alias anything
-      const std::size_t i_end = std::min(n, (b + 1) * kBlockRows);
-      if (lanes_on) {
-        LaneGroup g;
-        const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti,
-                               const A& tj) { scatter(force, torque, i, j, f, ti, tj); };
-        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
-          const RowParticle a = rowParticle(v, i);
-          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-            collect(g, v, a, i, p, v.col[p]);
-            if (g.n == width) flush<kEnergy>(v, g, width, diss, over, apply);
-          }
-        }
-        flush<kEnergy>(v, g, width, diss, over, apply);
-      } else {
-        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
-          const RowParticle a = rowParticle(v, i);
-          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-            interact<kEnergy>(v, a, p, diss, over,
-                              [&](std::uint32_t j, const V& f, const A& ti, const A& tj) {
-                                scatter(force, torque, i, j, f, ti, tj);
-                              });
-          }
-        }
-      }
+      blockRows<kEnergy>(v, row, b * kBlockRows, std::min(n, (b + 1) * kBlockRows), n, width, diss,
+                         over, force, torque, [](std::size_t, ContactDissipation&) {});
       storeBlock(b, diss, over);
     }
     addBlockSums(pass, blocks);
@@ -452,7 +469,6 @@ class ContactModelImpl final : public ContactModel<D> {
       for (std::size_t b = lo / kBlockRows; lo < hi && b * kBlockRows < hi; ++b) {
         ContactDissipation diss;
         bool over = false;
-        std::uint32_t touching = 0;
         // A cross pair's own share, in its place in pair order.
         const auto crossPair = [&](std::size_t i, ContactDissipation& d) {
           const KeptContact<D>& kept = B.cross_result[g++];
@@ -464,32 +480,9 @@ class ContactModelImpl final : public ContactModel<D> {
           force[i] -= kept.f.force;
           torque[i] -= kept.f.torque_i;
         };
-        const std::size_t i_end = std::min(hi, (b + 1) * kBlockRows);
-        LaneGroup group;
-        const auto apply = [&](std::uint32_t i, std::uint32_t j, const V& f, const A& ti,
-                               const A& tj) { scatter(force, torque, i, j, f, ti, tj); };
-        for (std::size_t i = b * kBlockRows; i < i_end; ++i) {
-          const RowParticle a = rowParticle(v, i);
-          for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-            const std::uint32_t j = col[p];
-            if (j >= hi) {
-              // The pending pairs come first in pair order: theirs before this one's share.
-              if (lanes_on) flush<kEnergy>(v, group, width, diss, over, apply);
-              crossPair(i, diss);
-              continue;
-            }
-            if (lanes_on) {
-              touching += collect(group, v, a, i, p, j);
-              if (group.n == width) flush<kEnergy>(v, group, width, diss, over, apply);
-              continue;
-            }
-            touching += interact<kEnergy>(v, a, p, diss, over,
-                                          [&](std::uint32_t, const V& f, const A& ti, const A& tj) {
-                                            scatter(force, torque, i, j, f, ti, tj);
-                                          });
-          }
-        }
-        if (lanes_on) flush<kEnergy>(v, group, width, diss, over, apply);
+        const std::uint32_t touching =
+            blockRows<kEnergy>(v, row, b * kBlockRows, std::min(hi, (b + 1) * kBlockRows), hi,
+                               width, diss, over, force, torque, crossPair);
         storeBlock(b, diss, over);
         B.block_touching[b] = touching;
       }
