@@ -188,8 +188,9 @@ int regressCheck(const std::string& reference, const std::string& lab, std::int6
     }
     const campaign::Summary s = key.summary;
     const std::string unit = key.unit.empty() || key.unit == "-" ? "" : " " + key.unit;
-    const std::string shown =
-        values.size() == m ? fmt(campaign::summarize(values).mean) + unit : "not recorded";
+    const bool recorded = values.size() == m;
+    const double mean = recorded ? campaign::summarize(values).mean : NAN;
+    const std::string shown = recorded ? fmt(mean) + unit : "not recorded";
     if (!guarded(s, m)) {
       std::cout << "  --   " << key.name << " = " << shown << ": not guarded at " << m << " seed"
                 << (m > 1 ? "s" : "") << " (the reference's scatter, "
@@ -198,8 +199,7 @@ int regressCheck(const std::string& reference, const std::string& lab, std::int6
       continue;
     }
     const double half = halfWidth(s, m);
-    const bool within =
-        values.size() == m && std::abs(campaign::summarize(values).mean - s.mean) <= half;
+    const bool within = recorded && std::abs(mean - s.mean) <= half;
     ok = ok && within;
     std::cout << "  " << (within ? "ok  " : "FAIL") << " " << key.name << " = " << shown
               << ", reference " << fmt(s.mean) << " +- " << fmt(half) << unit << "\n";
