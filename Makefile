@@ -13,7 +13,7 @@ ROCKLAB := $(BUILD)/rocklab
 DEMO_DIR := build/demo
 
 .PHONY: deps build demo test test-full test-slurm test-sanitize bench bench-packings catalogue references \
-  bond-model-reach \
+  bond-model-reach paper \
   gallery format clean
 
 # Installs only the Debian packages that are missing (a no-op when all are present);
@@ -94,6 +94,22 @@ catalogue: build
 	  $(ROCKLAB) report $$n --lab $(CATALOGUE_DIR)/lab.sqlite --out $(CATALOGUE_DIR)/$$name; \
 	done
 	@echo "catalogue: $(CATALOGUE_DIR)/*/index.html"
+
+# The paper's experiments as ensembles (protocols/campaigns/*-seeds.toml, 5 seeds each at full
+# size) into one notebook, each campaign's report, and the catalogue of what each gave beside
+# the paper's numbers (build/paper/catalogue.md). Campaigns done are skipped, so it can be run
+# again after a stop; PAPER_CAMPAIGNS picks a subset (the 3D ones are hours per seed).
+PAPER_DIR := build/paper
+PAPER_CAMPAIGNS ?= $(wildcard protocols/campaigns/*-seeds.toml)
+paper: build
+	@mkdir -p $(PAPER_DIR)
+	for c in $(PAPER_CAMPAIGNS); do \
+	  $(ROCKLAB) campaign run $$c --lab $(PAPER_DIR)/lab.sqlite --quiet && \
+	  $(ROCKLAB) campaign report $$c --lab $(PAPER_DIR)/lab.sqlite \
+	    --out $(PAPER_DIR)/$$(basename $$c .toml) || exit 1; \
+	done
+	$(ROCKLAB) campaign catalogue $(PAPER_CAMPAIGNS) --lab $(PAPER_DIR)/lab.sqlite \
+	  --out $(PAPER_DIR)/catalogue.md
 
 # The regression references of the quick protocols (tests/reference, checked by the e2e tests):
 # each protocol at eight seeds, their values, mean and scatter (tests/README.md says how a check

@@ -112,6 +112,28 @@ Value atStage(const RunData& r, const KeyResultRule& d, const std::string& prefi
   return std::nullopt;  // the pulse drowned at that stage: no velocity was recorded
 }
 
+// The measured k / k0 at the end over Kozeny-Carman's (equation 8) from the same porosity
+// change: 1 where the network follows Kozeny-Carman, as the paper finds (Figures 12-13).
+Value overKozenyCarman(const RunData& r, const KeyResultRule& d, const std::string& prefix,
+                       const std::string&) {
+  const Value k = recorded(r, d, prefix, "");
+  const SeriesData* kc = r.find(prefix + "kozeny_carman_over_k0");
+  if (!k || !kc || kc->value.empty() || !(kc->value.back() > 0.0)) return std::nullopt;
+  return *k / kc->value.back();
+}
+
+// The static constrained modulus over the dynamic one (rho vp_z^2) at a stage: 1 where the
+// small stress cycle stays elastic, as the paper checked (section 4.1).
+Value staticOverDynamic(const RunData& r, const KeyResultRule& d, const std::string& prefix,
+                        const std::string&) {
+  KeyResultRule part = d;  // its source: the static modulus
+  const Value s = atStage(r, part, prefix, part.source);
+  part.source = "modulus_z_dynamic_MPa";
+  const Value m = atStage(r, part, prefix, part.source);
+  if (!s || !m || !(*m > 0.0)) return std::nullopt;
+  return *s / *m;
+}
+
 KeyResultRule rec(std::string name) {
   return {std::move(name), recorded, "", "", 0.0, 0.0};
 }
@@ -183,6 +205,7 @@ std::vector<KeyResultRule> permeameterRules() {
       rec("k_over_k0_final"),
       rec("k_over_k0_final_along"),
       rec("k_over_k0_final_normal"),
+      {"k_over_kozeny_carman_final", overKozenyCarman, "k_over_k0_final", "", 0.0, 0.0},
       {"k_over_k0_at_half_peak_stress", atFractionOfPeak, "k_over_k0", "flow.mean_stress_MPa", 0.5,
        0.0},
       rec("porosity_initial"),
@@ -202,6 +225,7 @@ std::vector<KeyResultRule> ultrasonicRules() {
       stage("modulus_z_dynamic_MPa"),
       stage("shear_modulus_zx_dynamic_MPa"),
       stage("modulus_z_static_MPa"),
+      {"static_over_dynamic_modulus", staticOverDynamic, "modulus_z_static_MPa", "", 0.0, 0.0},
   };
 }
 

@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "lab/campaign/toml_text.hpp"
+#include "reports/key_results.hpp"
+#include "rigs/common/outputs.hpp"
 #include "rigs/registry.hpp"
 
 namespace rocklab::campaign {
@@ -74,6 +76,73 @@ void readHead(const TomlValue& t, Campaign& c, Reader& r, const TomlValue*& seed
   }
 }
 
+// A [[paper]] table: what the paper says of one of the campaign's results.
+void readPaperClaim(const TomlValue& t, Campaign& c, Reader& r) {
+  if (!t.is_table()) {
+    r.problem(t, "paper: a table per claim ([[paper]] with result, and number or says)");
+    return;
+  }
+  PaperClaim claim;
+  claim.at = r.at(t);
+  for (const auto& [k, v] : t.as_table()) {
+    auto text = [&](std::string& out, const char* what) {
+      if (!v.is_string() || v.as_string().str.empty()) {
+        r.problem(v, std::string("paper.") + k + ": " + what);
+      } else {
+        out = v.as_string().str;
+      }
+    };
+    if (k == "result") {
+      text(claim.result, "the key result the claim is about (text)");
+    } else if (k == "number") {
+      text(claim.number, "a [[number]] key of data/paper.toml (text)");
+    } else if (k == "says") {
+      text(claim.says, "what the paper says (text)");
+    } else if (k == "within") {
+      const bool pair = v.is_array() && v.as_array().size() == 2 &&
+                        (v.as_array()[0].is_floating() || v.as_array()[0].is_integer()) &&
+                        (v.as_array()[1].is_floating() || v.as_array()[1].is_integer());
+      auto number = [](const TomlValue& x) {
+        return x.is_integer() ? static_cast<double>(x.as_integer()) : x.as_floating();
+      };
+      const double low = pair ? number(v.as_array()[0]) : 0.0;
+      const double high = pair ? number(v.as_array()[1]) : 0.0;
+      if (!pair || !(low < high)) {
+        r.problem(v, "paper.within: [low, high], low < high, in the result's unit");
+      } else {
+        claim.fraction = true, claim.low = low, claim.high = high;
+      }
+    } else {
+      r.problem(v, "paper." + k + ": unknown key (paper.result, number, says, within)");
+    }
+  }
+  if (!t.as_table().count("result")) r.problem(t, "paper: missing paper.result");
+  if (!t.as_table().count("number") && !t.as_table().count("says")) {
+    r.problem(t, "paper: give paper.number (the paper's value) or paper.says (its words)");
+  }
+  c.paper.push_back(std::move(claim));
+}
+
+// Every claim's result is a key result of the protocol's rig, with a rule to evaluate it.
+void checkPaperResults(const Campaign& c, Reader& r) {
+  if (c.paper.empty()) return;
+  std::string rig;
+  try {
+    rig = rigs::checkProtocol(c.protocol, c.fixed).rig->name;
+  } catch (const protocol::ProtocolError&) {
+    return;  // the protocol's own problems are reported where it is checked
+  }
+  const rigs::Outputs* outputs = rigs::rigOutputs(rig);
+  for (const PaperClaim& p : c.paper) {
+    if (p.result.empty()) continue;
+    if (!outputs || !outputs->keyResult(p.result) || !reports::findKeyResultRule(rig, p.result)) {
+      r.TomlReader::problem(p.at + ": paper.result = \"" + p.result +
+                            "\" is not a key result of the " + rig + " rig (`rocklab keys " + rig +
+                            "` lists them)");
+    }
+  }
+}
+
 }  // namespace
 
 std::string Point::label() const {
@@ -120,8 +189,10 @@ Campaign readCampaign(const std::string& path) {
   std::vector<std::pair<std::string, const TomlValue*>> fixed, sweeps;
   bool zip = false;
   for (const auto& [k, v] : root.as_table()) {
-    if (!v.is_table()) {
-      r.problem(v, k + ": a key outside a table ([campaign], [set], [sweep], [slurm])");
+    if (k == "paper" && v.is_array()) {
+      for (const auto& t : v.as_array()) readPaperClaim(t, c, r);
+    } else if (!v.is_table()) {
+      r.problem(v, k + ": a key outside a table ([campaign], [set], [sweep], [slurm], [[paper]])");
     } else if (k == "campaign") {
       readHead(v, c, r, seeds);
       zip = v.as_table().count("combine") && v.at("combine").is_string() &&
@@ -133,7 +204,7 @@ Campaign readCampaign(const std::string& path) {
     } else if (k == "slurm") {
       r.slurm(v, c.slurm);
     } else {
-      r.problem(v, "[" + k + "]: unknown table ([campaign], [set], [sweep], [slurm])");
+      r.problem(v, "[" + k + "]: unknown table ([campaign], [set], [sweep], [slurm], [[paper]])");
     }
   }
   if (!root.as_table().count("campaign")) r.problem("missing the [campaign] table");
@@ -240,6 +311,7 @@ Campaign readCampaign(const std::string& path) {
   for (std::size_t k = 0; k < points.size(); ++k) {
     c.points.push_back({static_cast<int>(k), points[k]});
   }
+  checkPaperResults(c, r);
 
   r.throwIfAny();
   return c;

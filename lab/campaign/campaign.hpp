@@ -29,6 +29,19 @@ struct Point {
   std::string label() const;                 // "loading.confining_stress_MPa=5" or "base"
 };
 
+// What the paper says of a result the campaign measures (a [[paper]] table): the catalogue
+// (`rocklab campaign catalogue`) sets each point's ensemble beside it.
+struct PaperClaim {
+  std::string result;  // a key result of the protocol's rig ("band_angle_deg", "stage1.vp_z")
+  std::string number;  // the paper's number: a [[number]] key of data/paper.toml, or empty
+  std::string says;    // what the paper says, where it gives no number
+  // The fraction of seeds whose result is in [low, high], where the paper's claim is about
+  // each sample ("a band nearly normal to sigma_1"), not about the mean.
+  bool fraction = false;
+  double low = 0.0, high = 0.0;
+  std::string at;  // file:line of the table, for the catalogue's problems
+};
+
 struct Task {
   int index = 0;  // its number in the campaign (the Slurm array index)
   int point = 0;
@@ -45,6 +58,7 @@ struct Campaign {
   std::vector<protocol::Override> fixed;  // [set]: keys every run takes
   std::vector<Point> points;
   SlurmOptions slurm;
+  std::vector<PaperClaim> paper;
 
   // Every point x seed, the point varying slowest.
   std::vector<Task> tasks() const;

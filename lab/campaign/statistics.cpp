@@ -108,4 +108,13 @@ Difference compareMeans(const Summary& a, const Summary& b) {
   return d;
 }
 
+Proportion proportion(std::size_t k, std::size_t n) {
+  if (n == 0 || k > n) throw std::invalid_argument("proportion: k of n with 0 <= k <= n, n > 0");
+  const double z = 1.959963984540054;  // the normal's 97.5% quantile
+  const double p = static_cast<double>(k) / n, m = static_cast<double>(n), zz = z * z / m;
+  const double centre = (p + 0.5 * zz) / (1.0 + zz);
+  const double half = z / (1.0 + zz) * std::sqrt(p * (1.0 - p) / m + 0.25 * zz / m);
+  return {k, n, p, std::max(0.0, centre - half), std::min(1.0, centre + half)};
+}
+
 }  // namespace rocklab::campaign

@@ -23,6 +23,16 @@ struct Summary {
 
 Summary summarize(const std::vector<double>& values);
 
+// A fraction of seeds (k of n samples showed something) with its 95% Wilson score interval
+// (E. B. Wilson, JASA 22, 1927; method 3 of R. G. Newcombe, Statistics in Medicine 17, 1998,
+// which stays inside [0, 1] and keeps its coverage at 0 of 5 or 5 of 5). n > 0.
+struct Proportion {
+  std::size_t k = 0, n = 0;
+  double fraction = 0.0, low = 0.0, high = 0.0;
+};
+
+Proportion proportion(std::size_t k, std::size_t n);
+
 // Two ensembles' means compared: b.mean - a.mean with the half-width of Welch's 95% interval
 // of that difference (B. L. Welch, Biometrika 34, 1947: t at the Welch-Satterthwaite degrees
 // of freedom). A difference inside its interval is not resolved by the seeds: the two could

@@ -10,6 +10,7 @@
 #include "lab/cli/build_info.hpp"
 #include "lab/cli/calibrate_commands.hpp"
 #include "lab/cli/campaign_commands.hpp"
+#include "lab/cli/catalogue_commands.hpp"
 #include "lab/cli/lab_commands.hpp"
 #include "lab/cli/regress_commands.hpp"
 #include "lab/cli/study_commands.hpp"
@@ -589,6 +590,19 @@ void addCampaign(CLI::App& app, Action& action) {
   report->add_option("--out", o->out, "Output folder")->required();
   report->add_option("--data", o->data_dir, "Folder holding paper.toml");
   report->callback([&action, o] { action = [o] { return rocklab::cli::campaignReport(*o); }; });
+  auto cat = std::make_shared<rocklab::cli::CatalogueOptions>();
+  cat->data_dir = ROCKLAB_DATA_DIR;
+  auto* catalogue = c->add_subcommand(
+      "catalogue",
+      "The paper's experiments beside the paper's numbers: each campaign's [[paper]] claims "
+      "against its ensemble in the lab (mean and 95% interval, or the fraction of seeds), as "
+      "a Markdown table");
+  catalogue->add_option("campaigns", cat->files, "Campaign files (TOML)")->required();
+  catalogue->add_option("--lab", cat->lab, "Lab notebook (SQLite)");
+  catalogue->add_option("--out", cat->out, "Markdown file (default: standard output)");
+  catalogue->add_option("--data", cat->data_dir, "Folder holding paper.toml");
+  catalogue->callback(
+      [&action, cat] { action = [cat] { return rocklab::cli::campaignCatalogue(*cat); }; });
 }
 
 }  // namespace

@@ -67,6 +67,8 @@ const Outputs& outputs() {
                "the same, flow along the axis (both directions measured)"},
               {"k_over_k0_final_normal", "-",
                "the same, flow across the axis (both directions measured)"},
+              {"k_over_kozeny_carman_final", "-",
+               "k / k0 at the end over Kozeny-Carman's from the same porosity (equation 8)"},
               {"k_over_k0_at_half_peak_stress", "-",
                "permeability over the initial when the mean stress first reaches half its peak"},
               {"porosity_initial", "-", "porosity before loading"},

@@ -57,6 +57,8 @@ const Outputs& outputs() {
                "rho vs_zx^2 (at the last stage; stageN.NAME)"},
               {"modulus_z_static_MPa", "MPa",
                "static constrained modulus along the axis (at the last stage; stageN.NAME)"},
+              {"static_over_dynamic_modulus", "-",
+               "modulus_z_static_MPa / modulus_z_dynamic_MPa (at the last stage; stageN.NAME)"},
           });
   return o;
 }

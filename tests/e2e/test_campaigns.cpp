@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <thread>
 
@@ -203,6 +204,75 @@ TEST(Campaigns, AKilledTaskIsListedAndResumedFromItsCheckpointOnRequest) {
   fs::remove(reference_file);
   removeLabFiles(lab);
   removeLabFiles(reference);
+}
+
+// The catalogue: each [[paper]] claim against the campaign's ensemble, the mean and the
+// fraction of seeds computed again here from the notebook's rows.
+TEST(Campaigns, TheCatalogueSetsTheEnsembleBesideThePaper) {
+  Lab lab("catalogue");
+  const std::string file = lab.path + ".flow.toml";
+  const std::string claims = R"([campaign]
+name = "flow"
+protocol = ")" + sourceDir() +
+                             R"(/protocols/permeameter-plane-strain-2d-quick.toml"
+seeds = 3
+[[paper]]
+result = "k_over_kozeny_carman_final"
+number = "kozeny_carman_agreement_2d"
+[[paper]]
+result = "k_over_k0_final"
+says = "falls with stress"
+within = [0.0, 0.775]
+)";
+  std::ofstream(file) << claims;
+  const std::string out = lab.path + ".catalogue.md";
+  nb::Notebook n(lab.path);  // a lab where the campaign has not run yet
+  std::string text;
+  ASSERT_EQ(runRocklab("campaign catalogue " + file + " --lab " + lab.path, &text), 0) << text;
+  EXPECT_NE(text.find("| `flow` | `k_over_k0_final` | falls with stress | not run | 0 |"),
+            std::string::npos)
+      << text;
+  ASSERT_EQ(runRocklab("campaign run " + file + " --jobs 2 --quiet --lab " + lab.path, &text), 0)
+      << text;
+  ASSERT_EQ(
+      runRocklab("campaign catalogue " + file + " --lab " + lab.path + " --out " + out, &text), 0)
+      << text;
+  std::ifstream in(out);
+  const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The row of the mean: the paper's number with its source, the ensemble's mean of the
+  // three runs' k / k_KC, and where the paper's 1 falls.
+  const double k_kc = std::stod(
+      scalar(n,
+             "SELECT avg(r.value / (SELECT s.value FROM series s WHERE s.run_id = r.run_id AND "
+             "s.name = 'kozeny_carman_over_k0' ORDER BY s.step DESC LIMIT 1)) FROM results r "
+             "WHERE r.name = 'k_over_k0_final'"));
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      md, m,
+      std::regex(
+          R"(\| `k_over_kozeny_carman_final` \| 1 \(Section 3\.5\.4, text \(Figure 13\)\) \| )"
+          R"(([0-9.]+) &plusmn; ([0-9.e-]+) \| 3 \| (inside the interval|outside: [^|]+) \|)")))
+      << md;
+  EXPECT_NEAR(std::stod(m[1].str()), k_kc, 5e-4 * k_kc);
+  const double half = std::stod(m[2].str());
+  EXPECT_EQ(m[3].str() == "inside the interval", std::abs(k_kc - 1.0) <= half) << m[3].str();
+  // The row of the fraction: the seeds at or under 0.775, counted here.
+  const std::string k =
+      scalar(n, "SELECT count(*) FROM results WHERE name = 'k_over_k0_final' AND value <= 0.775");
+  EXPECT_NE(md.find("| " + k + " of 3 seeds in [0, 0.775]: "), std::string::npos) << md;
+  // A claim on a number the paper does not have: refused, the catalogue left as it was.
+  std::ofstream(file) << claims << "[[paper]]\nresult = \"porosity_initial\"\nnumber = \"none\"\n";
+  EXPECT_EQ(
+      runRocklab("campaign catalogue " + file + " --lab " + lab.path + " --out " + out, &text), 2);
+  EXPECT_NE(text.find("flow.toml:12: paper.number = \"none\" is not a [[number]]"),
+            std::string::npos)
+      << text;
+  std::ifstream again(out);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>()),
+            md);
+  fs::remove(file);
+  fs::remove(out);
+  removeLabFiles(lab);
 }
 
 // The campaigns that ship with the protocols are valid, every point of them.

@@ -140,6 +140,57 @@ combine = "zip"
   EXPECT_NE(problems("[campaign\n").find("not valid TOML"), std::string::npos);
 }
 
+// What the paper says of a result: read with the key result checked against the rig's,
+// every problem with its line.
+TEST_F(CampaignFile, PaperClaimsAreReadAndChecked) {
+  const Campaign c = readCampaign(write(R"([campaign]
+name = "n"
+protocol = "ucs.toml"
+seeds = 2
+[[paper]]
+result = "ucs_MPa"
+number = "ucs"
+[[paper]]
+result = "band_angle_deg"
+says = "nearly normal"
+within = [70, 90.0]
+)"));
+  ASSERT_EQ(c.paper.size(), 2u);
+  EXPECT_EQ(c.paper[0].result, "ucs_MPa");
+  EXPECT_EQ(c.paper[0].number, "ucs");
+  EXPECT_FALSE(c.paper[0].fraction);
+  EXPECT_TRUE(c.paper[1].fraction);
+  EXPECT_EQ(c.paper[1].low, 70.0);
+  EXPECT_EQ(c.paper[1].high, 90.0);
+  EXPECT_NE(c.paper[1].at.find("c.toml:8"), std::string::npos) << c.paper[1].at;  // its [[paper]]
+  const std::string p = problems(R"([campaign]
+name = "n"
+protocol = "ucs.toml"
+seeds = 2
+[[paper]]
+result = "ucs"
+within = [2, 1]
+colour = 3
+[[paper]]
+says = "x"
+)");
+  EXPECT_NE(p.find("c.toml:7: paper.within: [low, high], low < high"), std::string::npos) << p;
+  EXPECT_NE(p.find("c.toml:8: paper.colour: unknown key"), std::string::npos) << p;
+  EXPECT_NE(p.find("c.toml:5: paper: give paper.number"), std::string::npos) << p;
+  EXPECT_NE(p.find("c.toml:9: paper: missing paper.result"), std::string::npos) << p;
+  const std::string q = problems(R"([campaign]
+name = "n"
+protocol = "ucs.toml"
+seeds = 2
+[[paper]]
+result = "vp_z"
+number = "ucs"
+)");
+  EXPECT_NE(q.find("c.toml:5: paper.result = \"vp_z\" is not a key result of the biaxial rig"),
+            std::string::npos)
+      << q;
+}
+
 TEST(CampaignStatistics, StudentQuantilesMatchTheTables) {
   // t(0.975, df), e.g. Abramowitz & Stegun table 26.10 (to the 4 decimals they give).
   const std::pair<std::size_t, double> table[] = {{1, 12.7062}, {2, 4.3027},  {3, 3.1824},
@@ -177,6 +228,28 @@ TEST(CampaignStatistics, WelchIntervalOfADifferenceOfMeans) {
   EXPECT_NEAR(e.half, c.high - c.mean, 1e-9);
   EXPECT_FALSE(compareMeans(summarize({1.0}), b).known);
   EXPECT_FALSE(compareMeans(summarize({1.0}), b).resolved());
+}
+
+// Wilson's score interval of a fraction against the worked examples of Newcombe (1998,
+// Statistics in Medicine 17, Table I, method 3, to the 4 decimals given), and at the ends.
+TEST(CampaignStatistics, WilsonIntervalOfAFraction) {
+  struct Row {
+    std::size_t k, n;
+    double low, high;
+  };
+  for (const Row& r : {Row{81, 263, 0.2553, 0.3662}, Row{15, 148, 0.0624, 0.1605},
+                       Row{0, 20, 0.0, 0.1611}, Row{1, 29, 0.0061, 0.1718}}) {
+    const Proportion p = proportion(r.k, r.n);
+    EXPECT_NEAR(p.low, r.low, 5e-5) << r.k << " of " << r.n;
+    EXPECT_NEAR(p.high, r.high, 5e-5) << r.k << " of " << r.n;
+    EXPECT_DOUBLE_EQ(p.fraction, static_cast<double>(r.k) / r.n);
+  }
+  // 5 of 5 seeds: the mirror of 0 of 5, and never above 1.
+  const Proportion all = proportion(5, 5), none = proportion(0, 5);
+  EXPECT_DOUBLE_EQ(all.high, 1.0);
+  EXPECT_NEAR(all.low, 1.0 - none.high, 1e-12);
+  EXPECT_THROW(proportion(6, 5), std::invalid_argument);
+  EXPECT_THROW(proportion(0, 0), std::invalid_argument);
 }
 
 TEST(CampaignStatistics, SummaryOfAnEnsemble) {

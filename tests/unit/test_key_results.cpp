@@ -94,6 +94,29 @@ TEST(KeyResults, PrefixesPickATestACopyOrAStage) {
   EXPECT_NEAR(*evaluateKeyResult(perm, "k_over_k0_at_half_peak_stress"), 0.8, 1e-12);
 }
 
+// The comparisons the paper makes: the network's k / k0 over Kozeny-Carman's at the end, and
+// the static modulus over the dynamic one at a stage.
+TEST(KeyResults, RatiosToWhatThePaperComparesWith) {
+  RunData perm;
+  perm.rig = "permeameter";
+  perm.results["k_over_k0_final"] = {0.6, ""};
+  addSeries(perm, "kozeny_carman_over_k0", {1.0, 0.9, 0.75});
+  EXPECT_NEAR(*evaluateKeyResult(perm, "k_over_kozeny_carman_final"), 0.8, 1e-12);
+  perm.series.erase("kozeny_carman_over_k0");
+  EXPECT_FALSE(evaluateKeyResult(perm, "k_over_kozeny_carman_final").has_value());
+
+  RunData us;
+  us.rig = "ultrasonic";
+  addSeries(us, "stage.density_kg_per_m3", {2000, 2001}, 1000);  // stages at steps 1000, 1100
+  addSeries(us, "modulus_z_static_MPa", {850.0, 1800.0}, 1000);
+  addSeries(us, "modulus_z_dynamic_MPa", {1000.0, 2000.0}, 1000);
+  us.results["modulus_z_static_MPa"] = {1800.0, "MPa"};
+  us.results["modulus_z_dynamic_MPa"] = {2000.0, "MPa"};
+  EXPECT_NEAR(*evaluateKeyResult(us, "stage1.static_over_dynamic_modulus"), 0.85, 1e-12);
+  EXPECT_NEAR(*evaluateKeyResult(us, "static_over_dynamic_modulus"), 0.9, 1e-12);  // the last
+  EXPECT_FALSE(evaluateKeyResult(us, "stage3.static_over_dynamic_modulus").has_value());
+}
+
 // Every key result a rig declares has its rule here and every rule a declaration, and what
 // a rule reads is something the rig records: a definition cannot ask for a series no rig
 // writes.
