@@ -1,9 +1,12 @@
 #include "reports/campaign_report.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -142,6 +145,55 @@ void keyResultsTable(std::ostream& body, const CampaignData& c,
   summary.files.push_back("key-results.csv");
 }
 
+// A campaign over one numeric key (a size study over sample.count, a rate study): each key
+// result's mean with its 95% interval against that key's value, so that a reader sees where
+// a result converges and where a smaller sample sits on the curve. None for other campaigns.
+std::optional<Figure> sweepFigure(const CampaignData& c, const std::vector<std::string>& keys) {
+  std::string swept;
+  std::vector<std::pair<double, int>> at;  // the key's value, its point
+  for (const auto& [point, settings] : c.points) {
+    const auto eq = settings.find('=');
+    if (eq == std::string::npos || settings.find(", ") != std::string::npos) return std::nullopt;
+    const std::string key = settings.substr(0, eq);
+    if (!swept.empty() && key != swept) return std::nullopt;
+    swept = key;
+    char* end = nullptr;
+    const double x = std::strtod(settings.c_str() + eq + 1, &end);
+    if (end == settings.c_str() + eq + 1 || *end != '\0') return std::nullopt;
+    at.emplace_back(x, point);
+  }
+  if (at.size() < 2) return std::nullopt;
+  std::sort(at.begin(), at.end());
+  Figure f;
+  f.id = "sweep";
+  f.title = "Key results against " + swept;
+  f.caption =
+      "Each point's mean over its seeds with its 95% confidence interval (Student t), "
+      "against " +
+      swept + ".";
+  for (const std::string& key : keys) {
+    Series s;
+    s.label = "mean, 95% CI";
+    s.markers = true;
+    std::string unit;
+    for (const auto& [x, point] : at) {
+      auto it = c.statistics.find({point, key});
+      if (it == c.statistics.end()) continue;
+      const StatisticRow& r = it->second;
+      s.x.push_back(x);
+      s.y.push_back(r.mean);
+      s.low.push_back(r.low.value_or(r.mean));
+      s.high.push_back(r.high.value_or(r.mean));
+      unit = r.unit;
+    }
+    if (s.x.empty()) continue;
+    f.panels.push_back(
+        {swept, key + (unit.empty() || unit == "-" ? "" : " (" + unit + ")"), {std::move(s)}});
+  }
+  if (f.panels.empty()) return std::nullopt;
+  return f;
+}
+
 // A point's figures: each run's built alone and combined, with the rig's own ensemble
 // figures in place of those of the same id.
 std::vector<Figure> pointFigures(const std::vector<const RunData*>& runs, const Paper& paper) {
@@ -192,6 +244,10 @@ ReportSummary writeCampaignReport(const CampaignReportOptions& o) {
        << "</code></summary><pre>" << html(c.text) << "</pre></details>\n";
   tasksTable(body, c);
   keyResultsTable(body, c, keyResultNames(any), o.out, summary);
+  if (const auto sweep = sweepFigure(c, keyResultNames(any))) {
+    body << "<h2>Against the sweep</h2>\n";
+    writeFigure(*sweep, o.out, body, summary);
+  }
   body << "<h2>Figures</h2>\n";
   for (const auto& [point, point_runs] : runs) {
     body << "<h3>Point " << point << ": <code>" << html(c.points.at(point)) << "</code>, "

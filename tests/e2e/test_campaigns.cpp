@@ -6,6 +6,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <regex>
@@ -85,9 +86,33 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
   EXPECT_NE(csv.find("\n1,material.friction=0.5,broken_bond_fraction_at_peak,-,2,"),
             std::string::npos)
       << csv;
+  // Over one numeric key, each key result against it: each point's mean and interval, as
+  // the statistics hold them.
+  std::ifstream sweep_in(report + "/sweep.csv");
+  const std::string sweep(std::istreambuf_iterator<char>(sweep_in), {});
+  for (const std::string& friction : {"0.3", "0.5"}) {
+    const auto stat = rows(lab.path,
+                           "SELECT mean, ci95_low, ci95_high FROM campaign_statistics s JOIN "
+                           "campaign_points p ON p.campaign_id = s.campaign_id AND p.point = "
+                           "s.point WHERE p.settings = 'material.friction=" +
+                               friction + "' AND s.name = 'secant_bulk_modulus_MPa' LIMIT 1");
+    ASSERT_EQ(stat.size(), 1u);
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        sweep, m, std::regex("\n3,mean  95% CI," + friction + ",([^,]+),([^,]+),([^,\n]+)")))
+        << sweep;
+    double mean = 0, low = 0, high = 0;
+    ASSERT_EQ(std::sscanf(stat[0].c_str(), "%lf|%lf|%lf", &mean, &low, &high), 3) << stat[0];
+    EXPECT_NEAR(std::stod(m[1].str()), mean, 1e-8 * std::abs(mean));
+    EXPECT_NEAR(std::stod(m[2].str()), low, 1e-8 * std::abs(mean));
+    EXPECT_NEAR(std::stod(m[3].str()), high, 1e-8 * std::abs(mean));
+  }
   std::size_t figures = 0, banded = 0;
   for (const auto& e : fs::directory_iterator(report)) {
-    if (e.path().extension() != ".csv" || e.path().filename() == "key-results.csv") continue;
+    if (e.path().extension() != ".csv" || e.path().filename() == "key-results.csv" ||
+        e.path().filename() == "sweep.csv") {
+      continue;
+    }
     ++figures;
     std::ifstream in(e.path());
     std::string header, row;
