@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "lab/calibration/calibration.hpp"
@@ -326,6 +327,21 @@ int Driver::run() {
             << (all.empty() ? "" : " (going on)") << "\n";
   for (const Evaluation& e : all) {
     if (e.status != "proposed") print(e);
+  }
+  // Evaluations that failed (every run of a target lost: a node gone, the binary replaced
+  // under the pool) are run once more each time an unreached calibration is run again,
+  // before it goes on. Their whole batch is taken again, so that its campaigns are the same
+  // files: they rerun only the runs that did not complete. A run that fails by itself fails
+  // again the same way (a seed's run is deterministic) and stays failed.
+  if (status != "reached") {
+    std::set<int> lost;
+    for (const Evaluation& e : all) {
+      if (e.counts() && e.status == "failed") lost.insert(e.batch);
+    }
+    for (Evaluation& e : all) {
+      if (e.counts() && lost.count(e.batch)) e.status = "proposed";
+    }
+    if (!lost.empty()) status.clear(), reason.clear();
   }
   while (status.empty()) {
     // A batch proposed but not evaluated (a run killed halfway) goes first.

@@ -176,6 +176,24 @@ TEST(Calibrate, ATargetOutOfReachIsReportedWithTheClosestValueBeforeTheBudgetIsS
   EXPECT_NE(out.find("the closest predicted: ucs_MPa"), std::string::npos) << out;
   const auto n = rows(lab.path, "SELECT count(*) < 12 FROM calibration_evaluations");
   EXPECT_EQ(n, std::vector<std::string>{"1|"}) << "the budget of 12 was spent";
+  // An evaluation lost to the machine (every run of a target failed: a node gone, the binary
+  // replaced under the pool) is run again when the calibration is. Here one is marked so in
+  // the ledger while its runs are in the lab: it is evaluated again to the same misfit, and
+  // nothing runs twice.
+  const std::string misfit =
+      "SELECT status, misfit FROM calibration_evaluations WHERE evaluation = 1";
+  const auto before = rows(lab.path, misfit);
+  const auto runs = rows(lab.path, "SELECT count(*) FROM runs");
+  {
+    nb::Notebook notebook(lab.path);
+    notebook.db().exec("UPDATE calibration_evaluations SET status = 'failed' WHERE evaluation = 1");
+  }
+  EXPECT_EQ(runRocklab("calibrate " + file + " --jobs 2 --quiet --lab " + lab.path, &out), 1)
+      << out;
+  EXPECT_EQ(rows(lab.path, misfit), before);
+  EXPECT_EQ(rows(lab.path, "SELECT count(*) FROM runs"), runs);
+  EXPECT_EQ(rows(lab.path, "SELECT status FROM calibrations"),
+            std::vector<std::string>{"unreachable|"});
   removeCalibrationFiles(lab);
   fs::remove(file);
 }

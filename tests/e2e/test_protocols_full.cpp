@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -121,5 +122,40 @@ INSTANTIATE_TEST_SUITE_P(QuickProtocols, GuardAtEverySeed,
                            std::replace(name.begin(), name.end(), '-', '_');
                            return name;
                          });
+
+// Li & Holt section 4.1: the dynamic moduli from the velocities were "identical" to the
+// static ones of small stress cycles in the elastic range. On the full-size sample (8,000
+// spheres, 20 across, a P wavelength of 11 grains) at 0.5 and 2 MPa, before its cement
+// breaks: rho vp_z^2 against the constrained modulus of a 1e-4 strain cycle, the strain
+// the interior's. Measured over seeds 3, 4 and 5: 0.993, 0.952, 1.006 at 0.5 MPa and 1.059,
+// 1.003, 1.055 at 2 MPa (sd 0.03), so one seed is held within 10%, about three of its
+// standard deviations. On the quick twin's 1,500 spheres the P velocity is resolved to 10%
+// only and the ratio reads 0.84 +- 0.05 over 8 seeds: this test would fail there.
+TEST(FullProtocols, DynamicAndStaticModuliAgreeInTheElasticRange) {
+  Lab lab("dynamic-static");
+  std::string out;
+  ASSERT_EQ(runRocklab("run " + sourceDir() +
+                           "/protocols/ultrasonic-hydrostatic.toml --quiet --threads 2 "
+                           "--set 'loading.stages_MPa=[0.5, 2.0]' --lab " +
+                           lab.path,
+                       &out),
+            0)
+      << out;
+  const std::vector<std::string> stages = rows(
+      lab.path,
+      "SELECT s.value / d.value, e.value / v.value FROM series s JOIN series d ON d.run_id = "
+      "s.run_id AND d.step = s.step AND d.name = 'modulus_z_dynamic_MPa' JOIN series v ON "
+      "v.run_id = s.run_id AND v.step = s.step AND v.name = 'vp_z' JOIN series e ON e.run_id = "
+      "s.run_id AND e.step = s.step AND e.name = 'vp_z_error' WHERE s.name = "
+      "'modulus_z_static_MPa' ORDER BY s.step");
+  ASSERT_EQ(stages.size(), 2u);
+  for (const std::string& row : stages) {
+    double ratio = 0.0, error = 0.0;
+    ASSERT_EQ(std::sscanf(row.c_str(), "%lf|%lf", &ratio, &error), 2) << row;
+    EXPECT_LT(error, 0.02) << "the P velocity resolved to 2%: " << row;
+    EXPECT_NEAR(ratio, 1.0, 0.1) << "static over dynamic modulus: " << row;
+  }
+  removeLabFiles(lab);
+}
 
 }  // namespace
