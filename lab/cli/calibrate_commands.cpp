@@ -16,6 +16,7 @@
 #include "lab/campaign/toml_text.hpp"
 #include "lab/cli/build_info.hpp"
 #include "lab/cli/campaign_commands.hpp"
+#include "lab/cli/lab_commands.hpp"
 #include "reports/calibration_report.hpp"
 
 namespace rocklab::cli {
@@ -71,18 +72,6 @@ std::string campaignText(const Calibration& c, int experiment, const std::string
   const std::string slurm = campaign::slurmTableText(c.slurm);
   if (!slurm.empty()) t << "\n" << slurm;
   return t.str();
-}
-
-// Writes a file whole or not at all (a rename over the old one).
-void writeWhole(const std::string& path, const std::string& text) {
-  fs::create_directories(fs::path(path).parent_path());
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-  }
-  fs::rename(tmp, path);
 }
 
 calibration::TargetValue readTarget(notebook::Notebook& lab, const std::string& campaign, int point,

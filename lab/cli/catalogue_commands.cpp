@@ -2,14 +2,15 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <optional>
 #include <sstream>
 
 #include "lab/campaign/campaign.hpp"
 #include "lab/campaign/statistics.hpp"
+#include "lab/cli/lab_commands.hpp"
 #include "lab/notebook/notebook.hpp"
+#include "reports/html.hpp"
 #include "reports/key_results.hpp"
 #include "reports/paper.hpp"
 #include "reports/run_data.hpp"
@@ -23,17 +24,15 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string num(double x) {
-  std::ostringstream o;
-  o.precision(std::abs(x) >= 1e5 || (x != 0.0 && std::abs(x) < 1e-3) ? 3 : 4);
-  o << x;
-  return o.str();
+  return reports::num(x, 4);
 }
 
-// Each point's values of `result`, one per completed run of the campaign (none when the
-// campaign has not run in the lab).
-std::vector<std::vector<double>> valuesByPoint(notebook::Notebook& lab, const campaign::Campaign& c,
-                                               const std::string& result) {
-  std::vector<std::vector<double>> out(c.points.size());
+// For each claim, each point's values of its result, one per completed run of the campaign
+// (none when the campaign has not run in the lab). Each run is read once, for every claim.
+std::vector<std::vector<std::vector<double>>> valuesByClaim(notebook::Notebook& lab,
+                                                            const campaign::Campaign& c) {
+  std::vector<std::vector<std::vector<double>>> out(
+      c.paper.size(), std::vector<std::vector<double>>(c.points.size()));
   auto id = lab.db().prepare("SELECT id FROM campaigns WHERE name = ?");
   id.bind(1, c.name);
   if (!id.step()) return out;
@@ -43,9 +42,13 @@ std::vector<std::vector<double>> valuesByPoint(notebook::Notebook& lab, const ca
   q.bind(1, id.integer(0));
   while (q.step()) {
     const auto point = static_cast<std::size_t>(q.integer(0));
-    if (point >= out.size()) continue;
+    if (point >= c.points.size()) continue;
     const reports::RunData run = reports::loadRun(lab, q.integer(1));
-    if (const auto v = reports::evaluateKeyResult(run, result)) out[point].push_back(*v);
+    for (std::size_t k = 0; k < c.paper.size(); ++k) {
+      if (const auto v = reports::evaluateKeyResult(run, c.paper[k].result)) {
+        out[k][point].push_back(*v);
+      }
+    }
   }
   return out;
 }
@@ -120,7 +123,9 @@ int campaignCatalogue(const CatalogueOptions& o) {
   for (const campaign::Campaign& c : campaigns) {
     const std::string rig(rigs::checkProtocol(c.protocol, c.fixed).rig->name);
     const rigs::Outputs* outputs = rigs::rigOutputs(rig);
-    for (const campaign::PaperClaim& claim : c.paper) {
+    const auto values = valuesByClaim(lab, c);
+    for (std::size_t k = 0; k < c.paper.size(); ++k) {
+      const campaign::PaperClaim& claim = c.paper[k];
       const reports::PaperNumber* number =
           claim.number.empty() ? nullptr : paper.byKey(claim.number);
       const auto* decl = outputs ? outputs->keyResult(claim.result) : nullptr;
@@ -130,9 +135,8 @@ int campaignCatalogue(const CatalogueOptions& o) {
       if (number) said << num(number->value) << unit << " (" << number->source << ")";
       if (number && !claim.says.empty()) said << ": ";
       said << claim.says;
-      const auto values = valuesByPoint(lab, c, claim.result);
       for (const campaign::Point& point : c.points) {
-        const auto& v = values[static_cast<std::size_t>(point.index)];
+        const auto& v = values[k][static_cast<std::size_t>(point.index)];
         md << "| `" << c.name << "`";
         if (c.points.size() > 1) md << " " << point.label();
         md << " | `" << claim.result << "`" << unit << " | " << escaped(said.str()) << " | ";
@@ -151,16 +155,7 @@ int campaignCatalogue(const CatalogueOptions& o) {
     return 0;
   }
   // Written whole or not at all: a catalogue cut short would pass for a finished one.
-  const std::string tmp = o.out + ".part";
-  std::ofstream f(tmp);
-  f << md.str();
-  f.close();
-  if (!f) {
-    std::cerr << "cannot write '" << tmp << "'\n";
-    fs::remove(tmp);
-    return 1;
-  }
-  fs::rename(tmp, o.out);
+  writeWhole(o.out, md.str());
   std::cout << "wrote " << o.out << "\n";
   return 0;
 }

@@ -5,8 +5,10 @@
 #include <atomic>
 #include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
+#include <stdexcept>
 
 #include "lab/cli/build_info.hpp"
 #include "lab/core/simulation.hpp"
@@ -92,6 +94,18 @@ std::vector<protocol::Override> overridesOf(const std::vector<std::string>& sets
   std::vector<protocol::Override> o;
   for (const std::string& s : sets) o.push_back(protocol::parseOverride(s));
   return o;
+}
+
+void writeWhole(const std::string& path, const std::string& text) {
+  const auto dir = std::filesystem::path(path).parent_path();
+  if (!dir.empty()) std::filesystem::create_directories(dir);
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + tmp);
+  }
+  std::filesystem::rename(tmp, path);
 }
 
 int checkProtocol(const std::string& path, const std::vector<std::string>& sets) {

@@ -29,6 +29,9 @@ int resumeRun(std::int64_t run, const RunOptions& o);
 // The --set arguments as overrides; throws protocol::ProtocolError for one without '='.
 std::vector<protocol::Override> overridesOf(const std::vector<std::string>& sets);
 
+// Writes a file whole or not at all (a rename over the old one); throws when it cannot.
+void writeWhole(const std::string& path, const std::string& text);
+
 struct RunOutcome {
   int code = 0;  // as runProtocol's
   std::int64_t run = 0;
