@@ -216,6 +216,48 @@ std::vector<Figure> pointFigures(const std::vector<const RunData*>& runs, const 
   return out;
 }
 
+// Every point's curves of one figure drawn together (what the swept keys do to a curve, for
+// example formation porosity to Figures 1 and 2): each point's series over its seeds, with
+// its band, labelled with the point. A series every point draws alike (the paper's values) is
+// drawn once. None where a point lacks the figure or draws other panels.
+std::optional<Figure> comparedFigure(
+    const std::string& id, const std::vector<std::pair<std::string, std::vector<Figure>>>& points) {
+  std::vector<const Figure*> members;
+  for (const auto& [label, figures] : points) {
+    const auto it =
+        std::find_if(figures.begin(), figures.end(), [&](const Figure& f) { return f.id == id; });
+    if (it == figures.end()) return std::nullopt;
+    members.push_back(&*it);
+  }
+  const Figure& first = *members.front();
+  for (const Figure* m : members) {
+    if (m->panels.size() != first.panels.size()) return std::nullopt;
+  }
+  Figure f;
+  f.id = "compared-" + id;
+  f.title = first.title + ": the points compared";
+  f.caption =
+      "The points' figures above drawn together: each curve is a point's mean over its seeds "
+      "with its band, labelled with the point's swept values.";
+  for (std::size_t p = 0; p < first.panels.size(); ++p) {
+    Panel panel{first.panels[p].x_label, first.panels[p].y_label, {}};
+    std::vector<const Series*> drawn;
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      for (const Series& s : members[k]->panels[p].series) {
+        const bool alike = std::any_of(drawn.begin(), drawn.end(), [&](const Series* d) {
+          return d->label == s.label && d->x == s.x && d->y == s.y;
+        });
+        if (alike) continue;
+        drawn.push_back(&s);
+        panel.series.push_back(s);
+        panel.series.back().label = points[k].first + (s.label.empty() ? "" : ": " + s.label);
+      }
+    }
+    f.panels.push_back(std::move(panel));
+  }
+  return f;
+}
+
 }  // namespace
 
 ReportSummary writeCampaignReport(const CampaignReportOptions& o) {
@@ -249,14 +291,25 @@ ReportSummary writeCampaignReport(const CampaignReportOptions& o) {
     writeFigure(*sweep, o.out, body, summary);
   }
   body << "<h2>Figures</h2>\n";
+  std::vector<std::pair<std::string, std::vector<Figure>>> by_point;
   for (const auto& [point, point_runs] : runs) {
     body << "<h3>Point " << point << ": <code>" << html(c.points.at(point)) << "</code>, "
          << point_runs.size() << " completed runs</h3>\n";
     std::vector<const RunData*> ptrs;
     for (const RunData& r : point_runs) ptrs.push_back(&r);
-    for (Figure f : pointFigures(ptrs, paper)) {
+    by_point.emplace_back(c.points.at(point), pointFigures(ptrs, paper));
+    for (Figure f : by_point.back().second) {
       f.id = "point" + std::to_string(point) + "-" + f.id;
       writeFigure(f, o.out, body, summary);
+    }
+  }
+  // Past the palette's eight colours the curves could not be told apart.
+  if (by_point.size() > 1 && by_point.size() <= 8) {
+    body << "<h2>The points compared</h2>\n";
+    for (const Figure& f : by_point.front().second) {
+      if (const auto compared = comparedFigure(f.id, by_point)) {
+        writeFigure(*compared, o.out, body, summary);
+      }
     }
   }
   std::ofstream index(o.out + "/index.html");

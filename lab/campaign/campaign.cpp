@@ -112,8 +112,15 @@ void readPaperClaim(const TomlValue& t, Campaign& c, Reader& r) {
       } else {
         claim.fraction = true, claim.low = low, claim.high = high;
       }
+    } else if (k == "point") {
+      std::vector<std::pair<std::string, const TomlValue*>> keys;
+      if (v.is_table() && !v.as_table().empty()) Reader::flatten(v, "", keys);
+      if (keys.empty()) r.problem(v, "paper.point: a table of swept keys and their values");
+      for (const auto& [key, value] : keys) {
+        claim.point.push_back({key, tomlLiteral(*value), r.at(*value)});
+      }
     } else {
-      r.problem(v, "paper." + k + ": unknown key (paper.result, number, says, within)");
+      r.problem(v, "paper." + k + ": unknown key (paper.result, number, says, within, point)");
     }
   }
   if (!t.as_table().count("result")) r.problem(t, "paper: missing paper.result");
@@ -143,7 +150,52 @@ void checkPaperResults(const Campaign& c, Reader& r) {
   }
 }
 
+// Two values of a key alike: the same text, or the same number (2 and 2.0).
+bool sameValue(const std::string& a, const std::string& b) {
+  if (a == b) return true;
+  double x = 0.0, y = 0.0;
+  const auto rx = std::from_chars(a.data(), a.data() + a.size(), x);
+  const auto ry = std::from_chars(b.data(), b.data() + b.size(), y);
+  return rx.ec == std::errc() && rx.ptr == a.data() + a.size() && ry.ec == std::errc() &&
+         ry.ptr == b.data() + b.size() && x == y;
+}
+
+// A claim's `point` names swept keys, and some point of the campaign has all its values.
+void checkPaperPoints(const Campaign& c, Reader& r) {
+  for (const PaperClaim& p : c.paper) {
+    if (p.point.empty()) continue;
+    bool swept = true;
+    for (const auto& o : p.point) {
+      const bool found = std::any_of(c.points.begin(), c.points.end(), [&](const Point& q) {
+        return std::any_of(q.settings.begin(), q.settings.end(),
+                           [&](const protocol::Override& s) { return s.key == o.key; });
+      });
+      if (!found) {
+        r.TomlReader::problem(o.origin + ": paper.point." + o.key + ": not a key of the [sweep]");
+        swept = false;
+      }
+    }
+    if (swept && std::none_of(c.points.begin(), c.points.end(),
+                              [&](const Point& q) { return p.concerns(q); })) {
+      std::string labels;
+      for (const Point& q : c.points) labels += (labels.empty() ? "" : "; ") + q.label();
+      r.TomlReader::problem(p.point.front().origin +
+                            ": paper.point: no point of the campaign has these values (its "
+                            "points: " +
+                            labels + ")");
+    }
+  }
+}
+
 }  // namespace
+
+bool PaperClaim::concerns(const Point& p) const {
+  return std::all_of(point.begin(), point.end(), [&](const protocol::Override& o) {
+    return std::any_of(p.settings.begin(), p.settings.end(), [&](const protocol::Override& s) {
+      return s.key == o.key && sameValue(s.value, o.value);
+    });
+  });
+}
 
 std::string Point::label() const {
   if (settings.empty()) return "base";
@@ -312,6 +364,7 @@ Campaign readCampaign(const std::string& path) {
     c.points.push_back({static_cast<int>(k), points[k]});
   }
   checkPaperResults(c, r);
+  checkPaperPoints(c, r);
 
   r.throwIfAny();
   return c;

@@ -39,7 +39,11 @@ struct PaperClaim {
   // each sample ("a band nearly normal to sigma_1"), not about the mean.
   bool fraction = false;
   double low = 0.0, high = 0.0;
+  // The points the claim is about, by some of their swept values (`point = {KEY = VALUE}`):
+  // one sample of Figure 14 loaded along the flow, the other across it. Empty: every point.
+  std::vector<protocol::Override> point;
   std::string at;  // file:line of the table, for the catalogue's problems
+  bool concerns(const Point& p) const;
 };
 
 struct Task {

@@ -136,6 +136,7 @@ int campaignCatalogue(const CatalogueOptions& o) {
       if (number && !claim.says.empty()) said << ": ";
       said << claim.says;
       for (const campaign::Point& point : c.points) {
+        if (!claim.concerns(point)) continue;
         const auto& v = values[k][static_cast<std::size_t>(point.index)];
         md << "| `" << c.name << "`";
         if (c.points.size() > 1) md << " " << point.label();

@@ -107,6 +107,28 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
     EXPECT_NEAR(std::stod(m[2].str()), low, 1e-8 * std::abs(mean));
     EXPECT_NEAR(std::stod(m[3].str()), high, 1e-8 * std::abs(mean));
   }
+  // The points compared: each point's curves, as its own figure drew them, in one figure.
+  std::size_t compared = 0;
+  for (const auto& e : fs::directory_iterator(report)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("compared-", 0) != 0 || e.path().extension() != ".csv") continue;
+    ++compared;
+    std::ifstream in(e.path());
+    const std::string both(std::istreambuf_iterator<char>(in), {});
+    std::ifstream point_in(report + "/point1-" + name.substr(9));
+    ASSERT_TRUE(point_in) << name;
+    std::string header, row;
+    std::getline(point_in, header);
+    ASSERT_TRUE(std::getline(point_in, row)) << name;
+    // panel,series,x,y,...: the same row, its series named with its point.
+    const auto comma = row.find(',');
+    const std::string relabelled =
+        row.substr(0, comma + 1) + "material.friction=0.5: " + row.substr(comma + 1);
+    EXPECT_NE(both.find("\n" + relabelled + "\n"), std::string::npos) << name << ": " << row;
+    EXPECT_NE(both.find(",material.friction=0.3: "), std::string::npos) << name;
+  }
+  EXPECT_GE(compared, 1u);
+  EXPECT_NE(page.find("<h2>The points compared</h2>"), std::string::npos);
   std::size_t figures = 0, banded = 0;
   for (const auto& e : fs::directory_iterator(report)) {
     if (e.path().extension() != ".csv" || e.path().filename() == "key-results.csv" ||

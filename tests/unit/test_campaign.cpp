@@ -191,6 +191,66 @@ number = "ucs"
       << q;
 }
 
+// A claim about some of the points (Figure 14's two samples, each its own claim): the points
+// whose swept values match, 2 and 2.0 alike; a key not swept, or values no point has, refused.
+TEST_F(CampaignFile, APaperClaimCanBeAboutSomePoints) {
+  const Campaign c = readCampaign(write(R"([campaign]
+name = "n"
+protocol = "ucs.toml"
+seeds = 2
+combine = "zip"
+[sweep]
+"loading.confining_stress_MPa" = [0, 2.0]
+"bonds.tensile_strength_mean_MPa" = [5.0, 6.0]
+[[paper]]
+result = "ucs_MPa"
+number = "ucs"
+point = { "loading.confining_stress_MPa" = 2 }
+[[paper]]
+result = "ucs_MPa"
+says = "any"
+)"));
+  ASSERT_EQ(c.points.size(), 2u);
+  EXPECT_FALSE(c.paper[0].concerns(c.points[0]));
+  EXPECT_TRUE(c.paper[0].concerns(c.points[1]));
+  EXPECT_TRUE(c.paper[1].concerns(c.points[0]));
+  EXPECT_TRUE(c.paper[1].concerns(c.points[1]));
+  const std::string p = problems(R"([campaign]
+name = "n"
+protocol = "ucs.toml"
+seeds = 2
+combine = "zip"
+[sweep]
+"loading.confining_stress_MPa" = [0, 2.0]
+"bonds.tensile_strength_mean_MPa" = [5.0, 6.0]
+[[paper]]
+result = "ucs_MPa"
+says = "x"
+point = { "loading.confining_stress_MPa" = 0, "bonds.tensile_strength_mean_MPa" = 6 }
+[[paper]]
+result = "ucs_MPa"
+says = "y"
+point = { "material.friction" = 0.5 }
+)");
+  EXPECT_NE(p.find("c.toml:12: paper.point: no point of the campaign has these values (its "
+                   "points: loading.confining_stress_MPa=0, bonds.tensile_strength_mean_MPa=5.0; "),
+            std::string::npos)
+      << p;
+  EXPECT_NE(p.find("c.toml:16: paper.point.material.friction: not a key of the [sweep]"),
+            std::string::npos)
+      << p;
+  const std::string q = problems(R"([campaign]
+name = "n"
+protocol = "ucs.toml"
+seeds = 2
+[[paper]]
+result = "ucs_MPa"
+says = "z"
+point = 3
+)");
+  EXPECT_NE(q.find("c.toml:8: paper.point: a table of swept keys"), std::string::npos) << q;
+}
+
 TEST(CampaignStatistics, StudentQuantilesMatchTheTables) {
   // t(0.975, df), e.g. Abramowitz & Stegun table 26.10 (to the 4 decimals they give).
   const std::pair<std::size_t, double> table[] = {{1, 12.7062}, {2, 4.3027},  {3, 3.1824},
