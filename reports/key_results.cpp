@@ -183,6 +183,7 @@ std::vector<KeyResultRule> oedometerRules() {
       rec("cycle#_modulus_ratio"),
       rec("cored_to_virgin_initial_modulus_ratio"),
       rec("broken_bonds_by_coring"),
+      rec("porosity_after_formation"),
   };
 }
 

@@ -666,7 +666,13 @@ std::string Settings::effectiveText() const {
     const int line = given_.count(key) ? given_.at(key) : 0;
     edits.emplace_back(key, line, tomlLiteral(values.at(key)) + "  # " + o.label());
   }
-  const std::string head = "# The protocol as run: " + file_ + " with " + with + "\n";
+  // The file by its canonical path: the text (and the hash a campaign finds its runs by) must
+  // not depend on how the path was spelled ("protocols/p.toml" from the repository, the same
+  // file by its absolute path from elsewhere).
+  std::error_code ec;
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(file_, ec);
+  const std::string head =
+      "# The protocol as run: " + (ec ? file_ : canonical.string()) + " with " + with + "\n";
   // The edited file reads back to these settings, or (an override inside a multi-line value
   // or a table the file defines by dotted keys; an included file, whose keys must be in the
   // text for it to stand alone) every key is written out, table by table.

@@ -59,6 +59,9 @@ const Outputs& outputs() {
               {"cored_to_virgin_initial_modulus_ratio", "-",
                "initial modulus of the cored sample over the virgin's"},
               {"broken_bonds_by_coring", "-", "bonds broken by unloading the core"},
+              {"porosity_after_formation", "-",
+               "porosity of the formed sample, before it is cemented (what a campaign over the "
+               "packing varies)"},
           });
   return o;
 }

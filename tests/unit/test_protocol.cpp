@@ -339,6 +339,19 @@ TEST_F(Included, AMaterialFilesKeysJoinTheProtocolsCheckedAtTheirOwnLines) {
   EXPECT_EQ(parseProtocol(file, o.effectiveText(), sc).integer("sample.count"), 9);
 }
 
+// The protocol as run names its file by one path however it was spelled, so that a campaign
+// run from another folder (or given the protocol by another path) finds the runs it made.
+TEST_F(Included, TheProtocolAsRunDoesNotDependOnHowItsPathWasSpelled) {
+  const Schema sc = schema();
+  const std::string file = write("p.toml", kGood);
+  std::filesystem::create_directories(dir_ / "sub");
+  const std::string other = (dir_ / "sub" / ".." / "." / "p.toml").string();
+  const std::vector<Override> o = {parseOverride("sample.count=9")};
+  const std::string text = parseProtocol(file, kGood, sc, o).effectiveText();
+  EXPECT_EQ(parseProtocol(other, kGood, sc, o).effectiveText(), text);
+  EXPECT_NE(text.find("# The protocol as run: " + file + " with"), std::string::npos) << text;
+}
+
 TEST_F(Included, AKeyIsGivenOnceAndABadIncludeIsNamedAtItsLine) {
   const Schema sc = schema();
   auto problems = [&](const std::string& text) {
