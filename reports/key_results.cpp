@@ -90,6 +90,16 @@ Value atFractionOfPeak(const RunData& r, const KeyResultRule& d, const std::stri
   return seriesAt(r, fixed, prefix, "");
 }
 
+// y at the record where x peaks (k/k0 at the peak axial stress of a test through failure:
+// before it, what the stress did to the permeability; after it, what the failure did).
+Value atPeakOf(const RunData& r, const KeyResultRule& d, const std::string& prefix,
+               const std::string&) {
+  std::vector<double> x, y;
+  pair(r, prefix + d.x_series, prefix + d.source, x, y);
+  if (x.empty()) return std::nullopt;
+  return y[static_cast<std::size_t>(std::max_element(x.begin(), x.end()) - x.begin())];
+}
+
 // An ultrasonic value at stage N ("stage3.vp_z": the series' value at the Nth stage's step),
 // or at the last stage when unprefixed (the rig records those as results).
 Value atStage(const RunData& r, const KeyResultRule& d, const std::string& prefix,
@@ -209,6 +219,11 @@ std::vector<KeyResultRule> permeameterRules() {
       {"k_over_kozeny_carman_final", overKozenyCarman, "k_over_k0_final", "", 0.0, 0.0},
       {"k_over_k0_at_half_peak_stress", atFractionOfPeak, "k_over_k0", "flow.mean_stress_MPa", 0.5,
        0.0},
+      {"k_over_k0_at_peak_stress", atPeakOf, "k_over_k0", "flow.axial_stress_MPa", 0.0, 0.0},
+      {"k_over_k0_at_peak_stress_along", atPeakOf, "k_over_k0_along", "flow.axial_stress_MPa", 0.0,
+       0.0},
+      {"k_over_k0_at_peak_stress_normal", atPeakOf, "k_over_k0_normal", "flow.axial_stress_MPa",
+       0.0, 0.0},
       rec("porosity_initial"),
       rec("mean_stress_peak_MPa"),
       rec("flow_balance_error"),

@@ -67,6 +67,13 @@ const Outputs& outputs() {
                "the same, flow along the axis (both directions measured)"},
               {"k_over_k0_final_normal", "-",
                "the same, flow across the axis (both directions measured)"},
+              {"k_over_k0_at_peak_stress", "-",
+               "permeability over the initial at the peak axial stress (before it: what the "
+               "stress did; after it: what the failure did)"},
+              {"k_over_k0_at_peak_stress_along", "-",
+               "the same, flow along the axis (both directions measured)"},
+              {"k_over_k0_at_peak_stress_normal", "-",
+               "the same, flow across the axis (both directions measured)"},
               {"k_over_kozeny_carman_final", "-",
                "k / k0 at the end over Kozeny-Carman's from the same porosity (equation 8)"},
               {"k_over_k0_at_half_peak_stress", "-",

@@ -92,6 +92,15 @@ TEST(KeyResults, PrefixesPickATestACopyOrAStage) {
   addSeries(perm, "flow.mean_stress_MPa", {0.0, 2.0, 4.0, 6.0, 8.0});
   addSeries(perm, "k_over_k0", {1.0, 0.9, 0.8, 0.7, 0.6});
   EXPECT_NEAR(*evaluateKeyResult(perm, "k_over_k0_at_half_peak_stress"), 0.8, 1e-12);
+  // Through failure (Figure 14): k / k0 where the axial stress peaks, by direction.
+  RunData failed;
+  failed.rig = "permeameter";
+  addSeries(failed, "flow.axial_stress_MPa", {2.0, 6.0, 11.0, 9.0, 7.0});
+  addSeries(failed, "k_over_k0", {1.0, 0.99, 0.98, 1.1, 1.2});
+  addSeries(failed, "k_over_k0_normal", {1.0, 0.97, 0.95, 0.96, 0.99});
+  EXPECT_DOUBLE_EQ(*evaluateKeyResult(failed, "k_over_k0_at_peak_stress"), 0.98);
+  EXPECT_DOUBLE_EQ(*evaluateKeyResult(failed, "k_over_k0_at_peak_stress_normal"), 0.95);
+  EXPECT_FALSE(evaluateKeyResult(failed, "k_over_k0_at_peak_stress_along").has_value());
 }
 
 // The comparisons the paper makes: the network's k / k0 over Kozeny-Carman's at the end, and
