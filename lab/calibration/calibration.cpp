@@ -411,6 +411,7 @@ Calibration readCalibration(const std::string& path) {
       for (const auto& p : v.as_array()) c.parameters.push_back(readParameter(p, r));
     } else if (k == "set" && v.is_table()) {
       fixed = r.keys(v, "set");
+      c.fixed = fixed;
     } else if (k == "slurm" && v.is_table()) {
       r.slurm(v, c.slurm);
     } else {

@@ -55,8 +55,9 @@ struct Calibration {
   std::string file, text, name;
   Optimizer optimizer = Optimizer::Bayesian;
   int budget = 40, batch = 4, threads = 1, check_seeds = 0;
-  std::uint64_t seed = 1;  // the optimiser's random numbers
-  std::string material;    // the material file to write, resolved; empty: none
+  std::uint64_t seed = 1;                 // the optimiser's random numbers
+  std::string material;                   // the material file to write, resolved; empty: none
+  std::vector<protocol::Override> fixed;  // its own [set]: the material keys go in the file
   std::vector<Target> targets;
   std::vector<Parameter> parameters;
   std::vector<Experiment> experiments;

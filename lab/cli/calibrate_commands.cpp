@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -12,6 +14,7 @@
 
 #include "lab/calibration/calibration.hpp"
 #include "lab/calibration/ledger.hpp"
+#include "lab/calibration/material_file.hpp"
 #include "lab/calibration/optimizer.hpp"
 #include "lab/campaign/toml_text.hpp"
 #include "lab/cli/build_info.hpp"
@@ -85,6 +88,14 @@ calibration::TargetValue readTarget(notebook::Notebook& lab, const std::string& 
   auto real = [&](int col) { return q.isNull(col) ? calibration::kNaN : q.real(col); };
   v = {q.integer(0), real(1), real(2), real(3), real(4)};
   return v;
+}
+
+// x to `digits` significant digits: a fitted strength times its standard deviation's factor
+// written 33.26, not 33.260000000000005.
+double roundedTo(double x, int digits) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  return std::strtod(buf, nullptr);
 }
 
 std::string valueText(double v, int precision = 4) {
@@ -288,20 +299,20 @@ std::string Driver::material(const std::vector<Evaluation>& all, int best) const
     if (check) t << "; check " << meanText(check->targets[k], g.unit);
     t << "\n";
   }
-  std::map<std::string, std::vector<std::pair<std::string, std::string>>> tables;
+  // The file as it was, the calibration's own material keys and the fitted values written in
+  // (the fitted last: a key is fitted or fixed, never both).
+  std::vector<std::pair<std::string, std::string>> keys;
+  for (const protocol::Override& o : c_.fixed) {
+    if (calibration::isMaterialKey(o.key)) keys.emplace_back(o.key, o.value);
+  }
   for (std::size_t k = 0; k < c_.parameters.size(); ++k) {
     for (const auto& [key, factor] : c_.parameters[k].keys) {
-      const auto dot = key.rfind('.');
-      tables[key.substr(0, dot)].push_back(
-          {key.substr(dot + 1), campaign::numberText(e.values[k] * factor)});
+      keys.emplace_back(key, campaign::numberText(roundedTo(e.values[k] * factor, 10)));
     }
   }
-  for (auto& [table, keys] : tables) {
-    std::sort(keys.begin(), keys.end());
-    t << "\n[" << table << "]\n";
-    for (const auto& [key, value] : keys) t << key << " = " << value << "\n";
-  }
-  return t.str();
+  std::string previous;
+  if (std::ifstream in(c_.material); in) previous.assign(std::istreambuf_iterator<char>(in), {});
+  return calibration::materialText(previous, t.str(), keys);
 }
 
 int Driver::run() {

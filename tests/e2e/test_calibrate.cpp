@@ -43,6 +43,9 @@ TEST(Calibrate, GoesOnAfterAKillChecksTheBestPointAndWritesAMaterialProtocolsInc
   removeCalibrationFiles(lab);
   const std::string material = lab.path + ".material/cement.toml";
   fs::remove_all(lab.path + ".material");
+  // The material file as a user left it: its comments stay when the calibration writes it.
+  fs::create_directories(lab.path + ".material");
+  std::ofstream(material) << "# An old header\n\n[bonds]\n# The cement of the test.\n";
   const std::string file =
       calibrationFile(lab, "cement", 12.0, "check_seeds = 2\nmaterial = \"" + material + "\"\n");
   std::string out;
@@ -138,6 +141,9 @@ TEST(Calibrate, GoesOnAfterAKillChecksTheBestPointAndWritesAMaterialProtocolsInc
   EXPECT_NE(text.find("[bonds]\nshear_strength_mean_MPa = " + value.substr(0, value.size() - 1)),
             std::string::npos)
       << text;
+  EXPECT_NE(text.find("# The cement of the test.\n"), std::string::npos) << text;
+  EXPECT_EQ(text.find("# An old header"), std::string::npos) << text;
+  EXPECT_EQ(text.find("count"), std::string::npos) << text;  // [set], but not the material's
   const std::string protocol = lab.path + ".material/ucs.toml";
   {
     std::ifstream p(sourceDir() + "/protocols/biaxial-ucs-quick.toml");

@@ -12,6 +12,7 @@
 
 #include "lab/calibration/calibration.hpp"
 #include "lab/calibration/gaussian_process.hpp"
+#include "lab/calibration/material_file.hpp"
 #include "lab/calibration/minimize.hpp"
 #include "lab/calibration/optimizer.hpp"
 
@@ -377,6 +378,55 @@ value = 9.9
 tolerance = 1
 )" + kCement);
   EXPECT_NE(all.find("missing.toml"), std::string::npos) << all;
+}
+
+// The material file a calibration writes keeps what it did not fit: the file's other keys and
+// comments stay, the fitted ones take their new values where they were, a key the file lacked
+// goes under its table (or a new one), and the old header gives way to the new.
+TEST(MaterialFile, TheFittedKeysAreWrittenIntoTheFileAsItWas) {
+  const std::string previous = R"(# Material calibrated by an earlier run
+# evaluation 3
+
+[material]
+friction = 0.5
+density_kg_per_m3 = 2650
+
+[bonds]
+# Why the cement is what it is.
+tensile_strength_mean_MPa = 18.0  # hand-calibrated
+model = "parallel"
+)";
+  const std::string text = materialText(previous, "# New header\n",
+                                        {{"bonds.tensile_strength_mean_MPa", "12.5"},
+                                         {"bonds.tensile_strength_std_MPa", "2.5"},
+                                         {"grain_bonds.shear_strength_mean_MPa", "30.0"},
+                                         {"grain_bonds.tensile_strength_mean_MPa", "31.0"}});
+  EXPECT_EQ(text, R"(# New header
+
+[material]
+friction = 0.5
+density_kg_per_m3 = 2650
+
+[bonds]
+tensile_strength_std_MPa = 2.5
+# Why the cement is what it is.
+tensile_strength_mean_MPa = 12.5
+model = "parallel"
+
+[grain_bonds]
+tensile_strength_mean_MPa = 31.0
+shear_strength_mean_MPa = 30.0
+)");
+  // No file yet: the header and the keys.
+  EXPECT_EQ(materialText("", "# h\n", {{"bonds.modulus_GPa", "4.0"}}),
+            "# h\n\n[bonds]\nmodulus_GPa = 4.0\n");
+  // A key given dotted at the top cannot be placed: refused, not written twice.
+  EXPECT_THROW(materialText("bonds.modulus_GPa = 3.0\n", "# h\n", {{"bonds.modulus_GPa", "4.0"}}),
+               std::invalid_argument);
+  EXPECT_TRUE(isMaterialKey("grain_bonds.modulus_GPa"));
+  EXPECT_TRUE(isMaterialKey("material.friction"));
+  EXPECT_FALSE(isMaterialKey("numerics.threads"));
+  EXPECT_FALSE(isMaterialKey("sample.count"));
 }
 
 }  // namespace
