@@ -216,17 +216,25 @@ std::vector<Figure> pointFigures(const std::vector<const RunData*>& runs, const 
   return out;
 }
 
+// A point's figures in the report: its number, its swept values, its figures over the seeds.
+struct PointFigures {
+  int point = 0;
+  std::string settings;
+  std::vector<Figure> figures;
+};
+
 // Every point's curves of one figure drawn together (what the swept keys do to a curve, for
 // example formation porosity to Figures 1 and 2): each point's series over its seeds, with
-// its band, labelled with the point. A series every point draws alike (the paper's values) is
-// drawn once. None where a point lacks the figure or draws other panels.
-std::optional<Figure> comparedFigure(
-    const std::string& id, const std::vector<std::pair<std::string, std::vector<Figure>>>& points) {
+// its band, labelled "point N" (the caption says each point's values: a legend of them would
+// hide the curves). A series every point draws alike (the paper's values) is drawn once, with
+// its own label. None where a point lacks the figure or draws other panels.
+std::optional<Figure> comparedFigure(const std::string& id,
+                                     const std::vector<PointFigures>& points) {
   std::vector<const Figure*> members;
-  for (const auto& [label, figures] : points) {
-    const auto it =
-        std::find_if(figures.begin(), figures.end(), [&](const Figure& f) { return f.id == id; });
-    if (it == figures.end()) return std::nullopt;
+  for (const PointFigures& pf : points) {
+    const auto it = std::find_if(pf.figures.begin(), pf.figures.end(),
+                                 [&](const Figure& f) { return f.id == id; });
+    if (it == pf.figures.end()) return std::nullopt;
     members.push_back(&*it);
   }
   const Figure& first = *members.front();
@@ -237,22 +245,41 @@ std::optional<Figure> comparedFigure(
   f.id = "compared-" + id;
   f.title = first.title + ": the points compared";
   f.caption =
-      "The points' figures above drawn together: each curve is a point's mean over its seeds "
-      "with its band, labelled with the point's swept values.";
+      "The points' figures above drawn together, each curve a point's mean over its seeds "
+      "with its band:";
+  for (const PointFigures& pf : points) {
+    f.caption += (&pf == &points.front() ? " " : "; ") + std::string("point ") +
+                 std::to_string(pf.point) + ", " + pf.settings;
+  }
+  f.caption += ".";
+  auto same = [](const Series& a, const Series& b) {
+    return a.label == b.label && a.x == b.x && a.y == b.y;
+  };
   for (std::size_t p = 0; p < first.panels.size(); ++p) {
     Panel panel{first.panels[p].x_label, first.panels[p].y_label, {}};
-    std::vector<const Series*> drawn;
+    // Drawn alike by every point: once.
+    std::vector<const Series*> shared;
+    for (const Series& s : first.panels[p].series) {
+      const bool everywhere = std::all_of(members.begin(), members.end(), [&](const Figure* m) {
+        const auto& list = m->panels[p].series;
+        return std::any_of(list.begin(), list.end(), [&](const Series& x) { return same(x, s); });
+      });
+      if (everywhere) shared.push_back(&s);
+    }
     for (std::size_t k = 0; k < members.size(); ++k) {
+      std::vector<const Series*> own;
       for (const Series& s : members[k]->panels[p].series) {
-        const bool alike = std::any_of(drawn.begin(), drawn.end(), [&](const Series* d) {
-          return d->label == s.label && d->x == s.x && d->y == s.y;
-        });
-        if (alike) continue;
-        drawn.push_back(&s);
-        panel.series.push_back(s);
-        panel.series.back().label = points[k].first + (s.label.empty() ? "" : ": " + s.label);
+        if (std::none_of(shared.begin(), shared.end(),
+                         [&](const Series* x) { return same(*x, s); }))
+          own.push_back(&s);
+      }
+      for (const Series* s : own) {
+        panel.series.push_back(*s);
+        panel.series.back().label = "point " + std::to_string(points[k].point) +
+                                    (own.size() > 1 && !s->label.empty() ? ": " + s->label : "");
       }
     }
+    for (const Series* s : shared) panel.series.push_back(*s);
     f.panels.push_back(std::move(panel));
   }
   return f;
@@ -291,14 +318,14 @@ ReportSummary writeCampaignReport(const CampaignReportOptions& o) {
     writeFigure(*sweep, o.out, body, summary);
   }
   body << "<h2>Figures</h2>\n";
-  std::vector<std::pair<std::string, std::vector<Figure>>> by_point;
+  std::vector<PointFigures> by_point;
   for (const auto& [point, point_runs] : runs) {
     body << "<h3>Point " << point << ": <code>" << html(c.points.at(point)) << "</code>, "
          << point_runs.size() << " completed runs</h3>\n";
     std::vector<const RunData*> ptrs;
     for (const RunData& r : point_runs) ptrs.push_back(&r);
-    by_point.emplace_back(c.points.at(point), pointFigures(ptrs, paper));
-    for (Figure f : by_point.back().second) {
+    by_point.push_back({point, c.points.at(point), pointFigures(ptrs, paper)});
+    for (Figure f : by_point.back().figures) {
       f.id = "point" + std::to_string(point) + "-" + f.id;
       writeFigure(f, o.out, body, summary);
     }
@@ -306,7 +333,7 @@ ReportSummary writeCampaignReport(const CampaignReportOptions& o) {
   // Past the palette's eight colours the curves could not be told apart.
   if (by_point.size() > 1 && by_point.size() <= 8) {
     body << "<h2>The points compared</h2>\n";
-    for (const Figure& f : by_point.front().second) {
+    for (const Figure& f : by_point.front().figures) {
       if (const auto compared = comparedFigure(f.id, by_point)) {
         writeFigure(*compared, o.out, body, summary);
       }
