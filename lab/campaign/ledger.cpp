@@ -12,8 +12,7 @@
 namespace rocklab::campaign {
 
 std::string taskProtocolHash(const Campaign& c, const Task& t) {
-  return notebook::hashText(
-      rigs::checkProtocol(c.protocol, c.overrides(t)).settings.effectiveText());
+  return notebook::hashText(rigs::checkProtocol(c.protocol, c.overrides(t)).settings.identity());
 }
 
 std::int64_t registerCampaign(notebook::Notebook& lab, const Campaign& c) {
@@ -37,14 +36,18 @@ std::int64_t registerCampaign(notebook::Notebook& lab, const Campaign& c) {
 std::vector<TaskState> survey(notebook::Notebook& lab, const Campaign& c,
                               const std::vector<std::string>& hashes) {
   std::vector<TaskState> out;
-  // The completed run first, else the latest.
+  // The completed run first, else the latest. A run noted before runs were known by their
+  // settings is known by its text's hash: found too, so that a notebook kept from then does
+  // not run its campaigns again.
   auto s = lab.db().prepare(
-      "SELECT id, status, coalesce(reason, '') FROM runs WHERE protocol_hash = ? AND seed = ? "
-      "ORDER BY status = 'completed' DESC, id DESC LIMIT 1");
+      "SELECT id, status, coalesce(reason, '') FROM runs WHERE protocol_hash IN (?, ?) AND "
+      "seed = ? ORDER BY status = 'completed' DESC, id DESC LIMIT 1");
   const std::vector<Task> tasks = c.tasks();
   for (std::size_t k = 0; k < tasks.size(); ++k) {
     TaskState t{tasks[k], hashes.at(k), 0, "", ""};
-    s.bind(1, t.hash).bind(2, t.task.seed);
+    const std::string text_hash = notebook::hashText(
+        rigs::checkProtocol(c.protocol, c.overrides(tasks[k])).settings.effectiveText());
+    s.bind(1, t.hash).bind(2, text_hash).bind(3, t.task.seed);
     if (s.step()) {
       t.run = s.integer(0);
       t.status = s.text(1);

@@ -2,8 +2,9 @@
 // What the lab notebook keeps of a campaign (tables campaigns, campaign_points and
 // campaign_statistics, lab/notebook/README.md): which run each task made, and each point's
 // statistics over its seeds. A task is known by the hash of the protocol it runs (its
-// effective text: the protocol with the point's keys and the seed written in), so a
-// campaign run again finds the tasks already done, whatever became of the campaign file.
+// settings, protocol::Settings::identity: the protocol with the point's keys and the seed),
+// so a campaign run again finds the tasks already done, whatever became of the campaign
+// file, and whatever the protocol file says in other words (a comment, an included file).
 
 #include <cstdint>
 #include <string>

@@ -188,11 +188,10 @@ class SkippedWhileReplaying : public rigs::Recorder {
   const rigs::RunControl& control_;
 };
 
-rigs::Journal::Options journalOptions(const protocol::Settings& settings,
-                                      const std::string& protocol_text) {
+rigs::Journal::Options journalOptions(const protocol::Settings& settings) {
   rigs::Journal::Options o;
   o.every_s = settings.real("output.checkpoint_every_s");
-  o.protocol_hash = notebook::hashText(protocol_text);
+  o.protocol_hash = notebook::hashText(settings.identity());
   o.code_version = kGitRevision;
   return o;
 }
@@ -207,7 +206,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
   std::optional<rigs::Journal> journal;
   // The protocol as run (its text re-parsed to check it when keys were overridden): once.
   const std::string protocol_text = settings.effectiveText();
-  rigs::Journal::Options jo = journalOptions(settings, protocol_text);
+  rigs::Journal::Options jo = journalOptions(settings);
   if (resume_run > 0) {
     jo.dir = nb.runFilesDir(resume_run) + "/checkpoints";
     try {
@@ -222,6 +221,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
     info.protocol = settings.text("protocol.name");
     info.protocol_file = std::filesystem::absolute(protocol_file).string();
     info.protocol_text = protocol_text;
+    info.protocol_hash = jo.protocol_hash;
     info.rig = std::string(rig.name);
     info.code_version = kGitRevision;
     info.build_type = kBuildType;

@@ -391,7 +391,8 @@ RunWriter::RunWriter(Notebook& nb, const RunInfo& info, const std::vector<ParamR
       "started, code_version, build_type, seed, threads, host, pid, uuid) "
       "VALUES (?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, lower(hex(randomblob(16))))");
   s.bind(1, info.protocol).bind(2, info.protocol_file).bind(3, info.protocol_text);
-  s.bind(4, hashText(info.protocol_text)).bind(5, info.rig).bind(6, utcNow());
+  s.bind(4, info.protocol_hash.empty() ? hashText(info.protocol_text) : info.protocol_hash);
+  s.bind(5, info.rig).bind(6, utcNow());
   s.bind(7, info.code_version).bind(8, info.build_type).bind(9, info.seed);
   s.bind(10, info.threads).bind(11, hostName()).bind(12, static_cast<std::int64_t>(getpid()));
   s.run();

@@ -61,6 +61,7 @@ struct RunInfo {
   std::string protocol;       // protocol name
   std::string protocol_file;  // path it was read from
   std::string protocol_text;  // the whole file
+  std::string protocol_hash;  // of its settings (protocol::Settings::identity); "": of the text
   std::string rig;
   std::string code_version;  // git revision
   std::string build_type;

@@ -666,9 +666,8 @@ std::string Settings::effectiveText() const {
     const int line = given_.count(key) ? given_.at(key) : 0;
     edits.emplace_back(key, line, tomlLiteral(values.at(key)) + "  # " + o.label());
   }
-  // The file by its canonical path: the text (and the hash a campaign finds its runs by) must
-  // not depend on how the path was spelled ("protocols/p.toml" from the repository, the same
-  // file by its absolute path from elsewhere).
+  // The file by its canonical path: the notebook names the file it ran, however the path was
+  // spelled ("protocols/p.toml" from the repository, the same file from elsewhere).
   std::error_code ec;
   const std::filesystem::path canonical = std::filesystem::weakly_canonical(file_, ec);
   const std::string head =
@@ -705,6 +704,20 @@ std::string Settings::effectiveText() const {
     for (const auto& l : tables[t]) text += l + "\n";
   }
   return text;
+}
+
+std::string Settings::identity() const {
+  std::map<std::string, Value> values = values_;
+  for (const auto& [key, v] : unchosen_) values[key] = v;
+  std::string out;
+  for (const ParamDecl& d : schema_->all()) {
+    const auto it = values.find(d.key);
+    if (it == values.end() || d.key == "protocol.description") continue;
+    const std::string v = tomlLiteral(it->second);
+    if (d.fallback && tomlLiteral(*d.fallback) == v) continue;  // given or not, the same run
+    out += d.key + " = " + v + "\n";
+  }
+  return out;
 }
 
 }  // namespace rocklab::protocol

@@ -123,6 +123,12 @@ class Settings {
   // files, every key written out: parsing it alone gives these settings (the notebook keeps
   // it; `rocklab rerun` runs it again; a changed material file changes its hash).
   std::string effectiveText() const;
+  // What the run is, whatever the text says it with: every key away from its default (given
+  // by the file, its includes or an override), with its value, in the schema's order.
+  // Its hash tells a run in the notebook (a campaign's task already done), so that moving a
+  // protocol's material to an included file or editing a comment does not make it another
+  // protocol. The run's own choices (`--threads`) and the description are left out.
+  std::string identity() const;
 
  private:
   friend Settings parseProtocol(const std::string&, const std::string&, const Schema&,

@@ -339,8 +339,8 @@ TEST_F(Included, AMaterialFilesKeysJoinTheProtocolsCheckedAtTheirOwnLines) {
   EXPECT_EQ(parseProtocol(file, o.effectiveText(), sc).integer("sample.count"), 9);
 }
 
-// The protocol as run names its file by one path however it was spelled, so that a campaign
-// run from another folder (or given the protocol by another path) finds the runs it made.
+// The protocol as run names its file by one path however it was spelled (from the repository,
+// or from another folder by another path).
 TEST_F(Included, TheProtocolAsRunDoesNotDependOnHowItsPathWasSpelled) {
   const Schema sc = schema();
   const std::string file = write("p.toml", kGood);
@@ -488,4 +488,29 @@ TEST(Declarations, RulesAcrossFieldsNameTheFileLineAndKey) {
 }
 
 }  // namespace
+// A run is known by its settings, not by how its text says them: a comment, a key given at
+// its default, a material moved to an included file, the file's path, the threads chosen at
+// run time leave its identity as it is; a value changed does not.
+TEST_F(Included, TheIdentityIsTheSettingsNotTheirWording) {
+  const Schema sc = schema();
+  const std::string file = write("p.toml", kGood);
+  const std::string base = parseProtocol(file, kGood, sc).identity();
+  EXPECT_NE(base.find("formation.axial_stress_MPa = 30"), std::string::npos) << base;
+  EXPECT_EQ(base.find("numerics.local_damping"), std::string::npos) << base;  // its default
+  const std::string worded = std::string("# a comment\n") + kGood +
+                             "\n[numerics]\nlocal_damping = 0.7  # the default, given\n";
+  EXPECT_EQ(parseProtocol(write("q.toml", worded), worded, sc).identity(), base);
+  write("materials/f.toml", "[formation]\naxial_stress_MPa = 30\n");
+  std::string moved = kGood;
+  moved.erase(moved.find("axial_stress_MPa = 30\n"), 22);
+  moved = "include = \"materials/f.toml\"\n" + moved;
+  EXPECT_EQ(parseProtocol(write("r.toml", moved), moved, sc).identity(), base);
+  Settings chosen = parseProtocol(file, kGood, sc);  // a run's choice, as --threads is
+  chosen.runChoice("numerics.local_damping", 0.5);
+  EXPECT_EQ(chosen.identity(), base);
+  EXPECT_NE(
+      parseProtocol(file, kGood, sc, {parseOverride("formation.axial_stress_MPa=31")}).identity(),
+      base);
+}
+
 }  // namespace rocklab::protocol
