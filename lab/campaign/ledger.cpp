@@ -33,25 +33,69 @@ std::int64_t registerCampaign(notebook::Notebook& lab, const Campaign& c) {
   return s.integer(0);
 }
 
+namespace {
+
+// The hash a run is known by now, from the protocol text the notebook kept: for runs noted
+// when the hash was of the text, so that a notebook kept from then does not run its
+// campaigns again. Each run read once; "" for a text that no longer reads.
+class KeptHashes {
+ public:
+  explicit KeptHashes(notebook::Notebook& lab)
+      : q_(lab.db().prepare("SELECT id, status, coalesce(reason, ''), protocol_file, "
+                            "protocol_text FROM runs WHERE seed = ? AND protocol = ? AND rig = ? "
+                            "ORDER BY status = 'completed' DESC, id DESC")) {}
+
+  // The task's run among those of its seed and protocol name, by their settings.
+  bool find(TaskState& t, const std::string& name, const std::string& rig) {
+    q_.bind(1, t.task.seed).bind(2, name).bind(3, rig);
+    bool found = false;
+    while (!found && q_.step()) {
+      const std::int64_t id = q_.integer(0);
+      auto it = hashes_.find(id);
+      if (it == hashes_.end()) {
+        std::string h;
+        try {
+          h = notebook::hashText(
+              rigs::checkProtocolText(q_.text(3), q_.text(4)).settings.identity());
+        } catch (const std::exception&) {
+        }
+        it = hashes_.emplace(id, h).first;
+      }
+      if (it->second == t.hash) {
+        t.run = id, t.status = q_.text(1), t.reason = q_.text(2);
+        found = true;
+      }
+    }
+    q_.reset();
+    return found;
+  }
+
+ private:
+  notebook::Statement q_;
+  std::map<std::int64_t, std::string> hashes_;
+};
+
+}  // namespace
+
 std::vector<TaskState> survey(notebook::Notebook& lab, const Campaign& c,
                               const std::vector<std::string>& hashes) {
   std::vector<TaskState> out;
-  // The completed run first, else the latest. A run noted before runs were known by their
-  // settings is known by its text's hash: found too, so that a notebook kept from then does
-  // not run its campaigns again.
+  // The completed run first, else the latest.
   auto s = lab.db().prepare(
-      "SELECT id, status, coalesce(reason, '') FROM runs WHERE protocol_hash IN (?, ?) AND "
-      "seed = ? ORDER BY status = 'completed' DESC, id DESC LIMIT 1");
+      "SELECT id, status, coalesce(reason, '') FROM runs WHERE protocol_hash = ? AND seed = ? "
+      "ORDER BY status = 'completed' DESC, id DESC LIMIT 1");
+  KeptHashes kept(lab);
   const std::vector<Task> tasks = c.tasks();
   for (std::size_t k = 0; k < tasks.size(); ++k) {
     TaskState t{tasks[k], hashes.at(k), 0, "", ""};
-    const std::string text_hash = notebook::hashText(
-        rigs::checkProtocol(c.protocol, c.overrides(tasks[k])).settings.effectiveText());
-    s.bind(1, t.hash).bind(2, text_hash).bind(3, t.task.seed);
+    s.bind(1, t.hash).bind(2, t.task.seed);
     if (s.step()) {
       t.run = s.integer(0);
       t.status = s.text(1);
       t.reason = s.text(2);
+    } else {
+      const rigs::CheckedProtocol p = rigs::checkProtocol(c.protocol, c.overrides(tasks[k]));
+      kept.find(t, p.settings.text("protocol.name"), std::string(p.rig->name));
     }
     s.reset();
     out.push_back(std::move(t));

@@ -164,6 +164,31 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
   ASSERT_EQ(runRocklab("campaign run " + file + " --quiet --lab " + lab.path, &out), 0) << out;
   EXPECT_NE(out.find("0 of 4 runs to do"), std::string::npos) << out;
   EXPECT_EQ(rows(lab.path, "SELECT count(*) FROM runs"), std::vector<std::string>{"4|"});
+  // The protocol worded otherwise (a comment, a key given at its default, another path) is the
+  // same protocol: nothing to do.
+  {
+    std::ifstream in(sourceDir() + "/protocols/hydrostatic-quick.toml");
+    const std::string text(std::istreambuf_iterator<char>(in), {});
+    std::ofstream(lab.path + ".worded.toml")
+        << "# worded otherwise\n"
+        << text << "\n[output]\nsnapshots = true  # its default\n";
+    std::ifstream c_in(file);
+    std::string campaign(std::istreambuf_iterator<char>(c_in), {});
+    const std::string shipped = sourceDir() + "/protocols/hydrostatic-quick.toml";
+    campaign.replace(campaign.find(shipped), shipped.size(), lab.path + ".worded.toml");
+    std::ofstream(file) << campaign;
+  }
+  ASSERT_EQ(runRocklab("campaign run " + file + " --quiet --lab " + lab.path, &out), 0) << out;
+  EXPECT_NE(out.find("0 of 4 runs to do"), std::string::npos) << out;
+  // Runs a notebook noted by the hash of their text (before runs were known by their
+  // settings) are found by the text it kept.
+  {
+    nb::Notebook notebook(lab.path);
+    notebook.db().exec("UPDATE runs SET protocol_hash = 'of-the-text-' || id");
+  }
+  ASSERT_EQ(runRocklab("campaign run " + file + " --quiet --lab " + lab.path, &out), 0) << out;
+  EXPECT_NE(out.find("0 of 4 runs to do"), std::string::npos) << out;
+  fs::remove(lab.path + ".worded.toml");
   // A task's run is the run of the same settings by hand.
   const std::string seed =
       rows(lab.path, "SELECT seed FROM campaign_points WHERE point = 1 ORDER BY seed DESC")[0];
