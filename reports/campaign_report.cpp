@@ -1,6 +1,7 @@
 #include "reports/campaign_report.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -29,6 +30,7 @@ struct TaskRow {
   int point = 0;
   std::int64_t seed = 0, run = 0;
   std::string settings, status, reason;
+  std::set<std::string> warnings;  // the kinds its run warned of (each message's words before ':')
 };
 
 struct StatisticRow {
@@ -45,6 +47,24 @@ struct CampaignData {
   std::map<int, std::string> points;  // point -> its settings
   std::map<std::pair<int, std::string>, StatisticRow> statistics;
 };
+
+// A warning's kind: its words before the first ':' or ';', each number written '#' ("the
+// confining stress strayed #% from its target during loading"), so that runs count together.
+std::string warningKind(const std::string& text) {
+  const std::string head = text.substr(0, text.find_first_of(":;"));
+  std::string kind;
+  for (std::size_t k = 0; k < head.size(); ++k) {
+    if (!std::isdigit(static_cast<unsigned char>(head[k]))) {
+      kind += head[k];
+      continue;
+    }
+    while (k + 1 < head.size() && (std::isdigit(static_cast<unsigned char>(head[k + 1])) ||
+                                   head[k + 1] == '.' || head[k + 1] == 'e' || head[k + 1] == '-'))
+      ++k;
+    kind += '#';
+  }
+  return kind;
+}
 
 CampaignData loadCampaign(notebook::Notebook& nb, const std::string& name) {
   CampaignData c;
@@ -70,6 +90,13 @@ CampaignData loadCampaign(notebook::Notebook& nb, const std::string& name) {
     c.points[row.point] = row.settings;
     c.tasks.push_back(std::move(row));
   }
+  auto w = db.prepare("SELECT text FROM messages WHERE run_id = ? AND level = 'warning'");
+  for (TaskRow& row : c.tasks) {
+    if (!row.run) continue;
+    w.bind(1, row.run);
+    while (w.step()) row.warnings.insert(warningKind(w.text(0)));
+    w.reset();
+  }
   auto s = db.prepare(
       "SELECT point, name, n, mean, std, ci95_low, ci95_high, unit FROM campaign_statistics "
       "WHERE campaign_id = ?");
@@ -89,15 +116,34 @@ std::string interval(const StatisticRow& s) {
   return o.str();
 }
 
+// The tasks, and what their runs warned of: an ensemble whose every run warned that its
+// loading was not quasi-static measures the rate as much as the rock.
 void tasksTable(std::ostream& body, const CampaignData& c) {
-  body << "<h2>Tasks</h2>\n<table><tr><th>point</th><th>settings</th><th>seed</th><th>run</th>"
-          "<th>status</th></tr>\n";
+  body << "<h2>Tasks</h2>\n";
+  std::map<std::string, int> kinds;
+  int with_run = 0;
   for (const TaskRow& t : c.tasks) {
+    with_run += t.run > 0;
+    for (const std::string& k : t.warnings) ++kinds[k];
+  }
+  if (!kinds.empty()) {
+    body << "<p>Warnings of the runs:</p>\n<ul>\n";
+    for (const auto& [kind, runs] : kinds) {
+      body << "<li>" << html(kind) << ": " << runs << " of " << with_run << " runs</li>\n";
+    }
+    body << "</ul>\n";
+  }
+  body << "<table><tr><th>point</th><th>settings</th><th>seed</th><th>run</th><th>status</th>"
+          "<th>warnings</th></tr>\n";
+  for (const TaskRow& t : c.tasks) {
+    std::string warned;
+    for (const std::string& k : t.warnings) warned += (warned.empty() ? "" : "; ") + k;
     body << "<tr><td>" << t.point << "</td><td><code>" << html(t.settings) << "</code></td><td>"
          << t.seed << "</td><td>" << (t.run ? std::to_string(t.run) : "&ndash;")
          << "</td><td class=\"status-" << html(t.status) << "\">"
          << (t.status.empty() ? "not run" : html(t.status))
-         << (t.reason.empty() ? "" : ": " + html(t.reason)) << "</td></tr>\n";
+         << (t.reason.empty() ? "" : ": " + html(t.reason)) << "</td><td>" << html(warned)
+         << "</td></tr>\n";
   }
   body << "</table>\n";
 }

@@ -71,6 +71,14 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
                  "SELECT count(*) FROM campaign_statistics WHERE n = 2 AND name = "
                  "'broken_bond_fraction_at_peak'"),
             std::vector<std::string>{"2|"});
+  // Two runs warned alike but for their numbers: one kind of warning, counted over the runs.
+  {
+    nb::Notebook notebook(lab.path);
+    notebook.db().exec(
+        "INSERT INTO messages (run_id, step, time_s, level, text) VALUES "
+        "(1, 0, 0, 'warning', 'the walls strayed 1.5% from their target: lower the rate'), "
+        "(2, 0, 0, 'warning', 'the walls strayed 2.25e-1% from their target; lower the rate')");
+  }
   // The report: the key results per point, and each figure over the seeds with its spread.
   const std::string report = lab.path + ".report";
   ASSERT_EQ(runRocklab("campaign report " + file + " --lab " + lab.path + " --out " + report, &out),
@@ -81,6 +89,8 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
   EXPECT_NE(page.find("Point 1: <code>material.friction=0.5</code>, 2 completed runs"),
             std::string::npos);
   EXPECT_NE(page.find("Over 2 seeds (runs "), std::string::npos);
+  EXPECT_NE(page.find("<li>the walls strayed #% from their target: 2 of 4 runs</li>"),
+            std::string::npos);
   std::ifstream csv_in(report + "/key-results.csv");
   const std::string csv(std::istreambuf_iterator<char>(csv_in), {});
   EXPECT_NE(csv.find("\n1,material.friction=0.5,broken_bond_fraction_at_peak,-,2,"),
