@@ -779,7 +779,8 @@ TEST(Protocols, APermeameterKilledInItsLoadingResumesToTheUninterruptedRun) {
   std::filesystem::remove_all(killed.path + ".files");
 }
 
-// A run whose protocol or code changed since its checkpoint is refused with the reason.
+// A run whose protocol (a value, not its wording) or code changed since its checkpoint is
+// refused with the reason.
 TEST(Protocols, ResumeRefusesAChangedProtocol) {
   Lab lab("resume-refused");
   std::string out;
@@ -787,7 +788,10 @@ TEST(Protocols, ResumeRefusesAChangedProtocol) {
       resume::killDuringLoading(resume::start(resume::quickHydrostatic(lab.path)), lab.path, 0.0));
   {
     nb::Notebook n(lab.path);
-    n.db().exec("UPDATE runs SET protocol_text = protocol_text || '\n# edited' WHERE id = 1");
+    ASSERT_EQ(scalar(n, "SELECT instr(protocol_text, 'stress_max_MPa = 60.0') > 0 FROM runs"), "1");
+    n.db().exec(
+        "UPDATE runs SET protocol_text = replace(protocol_text, 'stress_max_MPa = 60.0', "
+        "'stress_max_MPa = 61.0') || '\n# edited' WHERE id = 1");
   }
   EXPECT_EQ(rocklab::testing::runRocklab("resume 1 --lab " + lab.path, &out), 2);
   EXPECT_NE(out.find("the protocol changed since the checkpoint"), std::string::npos) << out;
