@@ -191,10 +191,8 @@ number = "ucs"
       << q;
 }
 
-// A claim about some of the points (Figure 14's two samples, each its own claim): the points
-// whose swept values match, 2 and 2.0 alike; a key not swept, or values no point has, refused.
-TEST_F(CampaignFile, APaperClaimCanBeAboutSomePoints) {
-  const Campaign c = readCampaign(write(R"([campaign]
+// Two points, each sweep's values zipped (the claims' file lines count from this head's).
+constexpr const char* kZipped = R"([campaign]
 name = "n"
 protocol = "ucs.toml"
 seeds = 2
@@ -202,7 +200,12 @@ combine = "zip"
 [sweep]
 "loading.confining_stress_MPa" = [0, 2.0]
 "bonds.tensile_strength_mean_MPa" = [5.0, 6.0]
-[[paper]]
+)";
+
+// A claim about some of the points (Figure 14's two samples, each its own claim): the points
+// whose swept values match, 2 and 2.0 alike; a key not swept, or values no point has, refused.
+TEST_F(CampaignFile, APaperClaimCanBeAboutSomePoints) {
+  const Campaign c = readCampaign(write(std::string(kZipped) + R"([[paper]]
 result = "ucs_MPa"
 number = "ucs"
 point = { "loading.confining_stress_MPa" = 2 }
@@ -215,15 +218,7 @@ says = "any"
   EXPECT_TRUE(c.paper[0].concerns(c.points[1]));
   EXPECT_TRUE(c.paper[1].concerns(c.points[0]));
   EXPECT_TRUE(c.paper[1].concerns(c.points[1]));
-  const std::string p = problems(R"([campaign]
-name = "n"
-protocol = "ucs.toml"
-seeds = 2
-combine = "zip"
-[sweep]
-"loading.confining_stress_MPa" = [0, 2.0]
-"bonds.tensile_strength_mean_MPa" = [5.0, 6.0]
-[[paper]]
+  const std::string p = problems(std::string(kZipped) + R"([[paper]]
 result = "ucs_MPa"
 says = "x"
 point = { "loading.confining_stress_MPa" = 0, "bonds.tensile_strength_mean_MPa" = 6 }
