@@ -153,37 +153,49 @@ campaign::TaskState collectShard(notebook::Notebook& lab, campaign::TaskState t,
   return t;
 }
 
-// The whole campaign on one line: done, running, failed, time left.
+// The whole campaign on one line: done, running, failed, time left. On a terminal the line
+// is redrawn in place; off one (a log file, a batch job's output) each task's end is a line
+// of its own, so that a log shows how the campaign went.
 class Progress {
  public:
   Progress(std::size_t total, std::size_t done, int jobs, bool show)
-      : total_(total), done_(done), jobs_(jobs), show_(show && isatty(STDERR_FILENO)) {}
+      : total_(total), done_(done), jobs_(jobs), show_(show), tty_(isatty(STDERR_FILENO)) {}
   void started() { ++running_; }
-  void ended(bool ok, double seconds_taken) {
+  void ended(const std::string& name, const campaign::TaskState& t, double seconds_taken) {
+    const bool ok = t.status == "completed";
     --running_;
     ++(ok ? done_ : failed_);
     ++timed_;
     spent_ += seconds_taken;
+    if (show_ && !tty_) {
+      std::cerr << "campaign " << name << ": task " << t.task.index << " (point " << t.task.point
+                << ", seed " << t.task.seed << ") " << (t.status.empty() ? "lost" : t.status)
+                << " after " << seconds(seconds_taken) << "; " << state() << "\n";
+    }
   }
   void print(const std::string& name, bool last = false) const {
-    std::ostringstream line;
-    line << "campaign " << name << ": " << done_ << "/" << total_ << " done, " << running_
-         << " running, " << failed_ << " failed";
-    const std::size_t left = total_ - done_ - failed_;
-    if (timed_ > 0 && left > 0) {
-      line << ", " << seconds(spent_ / timed_ * left / std::max(1, jobs_)) << " left";
-    }
-    if (show_) {
-      std::cerr << "\r" << line.str() << "\033[K" << (last ? "\n" : "") << std::flush;
+    if (!show_) return;
+    const std::string line = "campaign " + name + ": " + state();
+    if (tty_) {
+      std::cerr << "\r" << line << "\033[K" << (last ? "\n" : "") << std::flush;
     } else if (last) {
-      std::cerr << line.str() << "\n";
+      std::cerr << line << "\n";
     }
   }
 
  private:
+  std::string state() const {
+    std::ostringstream line;
+    line << done_ << "/" << total_ << " done, " << running_ << " running, " << failed_ << " failed";
+    const std::size_t left = total_ - done_ - failed_;
+    if (timed_ > 0 && left > 0) {
+      line << ", " << seconds(spent_ / timed_ * left / std::max(1, jobs_)) << " left";
+    }
+    return line.str();
+  }
   std::size_t total_, done_, failed_ = 0, running_ = 0, timed_ = 0;
   int jobs_;
-  bool show_;
+  bool show_, tty_;
   double spent_ = 0.0;
 };
 
@@ -311,7 +323,7 @@ int runLocal(const CampaignOptions& o, const Opened& x) {
     const campaign::TaskState t = collectShard(lab, queue[k], dir);
     if (t.run > 0) campaign::recordTask(lab, id, c, t);
     states[static_cast<std::size_t>(t.task.index)] = t;
-    progress.ended(t.status == "completed",
+    progress.ended(c.name, t,
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     if (g_stop.load() != 0) next = queue.size();  // interrupted: start nothing more
   }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <regex>
+#include <sstream>
 #include <thread>
 
 #include "tests/e2e/protocol_support.hpp"
@@ -36,10 +37,19 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
   std::string out;
   ASSERT_EQ(runRocklab("campaign check " + file, &out), 0) << out;
   EXPECT_NE(out.find("2 points x 2 seeds = 4 runs"), std::string::npos) << out;
-  ASSERT_EQ(runRocklab("campaign run " + file + " --jobs 2 --quiet --lab " + lab.path, &out), 0)
-      << out;
+  ASSERT_EQ(runRocklab("campaign run " + file + " --jobs 2 --lab " + lab.path, &out), 0) << out;
   EXPECT_EQ(rows(lab.path, "SELECT count(*) FROM runs WHERE status = 'completed'"),
             std::vector<std::string>{"4|"});
+  // Off a terminal, each task's end is a line of the log: which task, how it ended, the count.
+  {
+    const std::regex ended(
+        "campaign friction: task [0-3] \\(point [01], seed [0-9]+\\) completed after [^;]+; "
+        "[1-4]/4 done, [01] running, 0 failed(, [^,]+ left)?");
+    std::istringstream lines(out);
+    std::size_t n = 0;
+    for (std::string line; std::getline(lines, line);) n += std::regex_match(line, ended);
+    EXPECT_EQ(n, 4u) << out;
+  }
   // Each task's run noted once, from its own process and shard.
   EXPECT_EQ(rows(lab.path, "SELECT count(DISTINCT run_id) FROM campaign_points"),
             std::vector<std::string>{"4|"});
