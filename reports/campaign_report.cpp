@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lab/campaign/statistics.hpp"
 #include "lab/notebook/notebook.hpp"
 #include "reports/ensemble.hpp"
 #include "reports/figures/figures.hpp"
@@ -30,6 +32,7 @@ struct TaskRow {
   int point = 0;
   std::int64_t seed = 0, run = 0;
   std::string settings, status, reason;
+  double core_seconds = 0.0;       // its run's wall time times its threads
   std::set<std::string> warnings;  // the kinds its run warned of (each message's words before ':')
 };
 
@@ -77,7 +80,8 @@ CampaignData loadCampaign(notebook::Notebook& nb, const std::string& name) {
   c.protocol = q.text(4);
   auto t = db.prepare(
       "SELECT p.point, p.seed, p.settings, coalesce(p.run_id, 0), coalesce(r.status, ''), "
-      "coalesce(r.reason, '') FROM campaign_points p LEFT JOIN runs r ON r.id = p.run_id "
+      "coalesce(r.reason, ''), coalesce(r.wall_seconds * max(r.threads, 1), 0) FROM "
+      "campaign_points p LEFT JOIN runs r ON r.id = p.run_id "
       "WHERE p.campaign_id = ? ORDER BY p.point, p.seed");
   t.bind(1, c.id);
   while (t.step()) {
@@ -86,7 +90,8 @@ CampaignData loadCampaign(notebook::Notebook& nb, const std::string& name) {
                 t.integer(3),
                 t.text(2),
                 t.text(4),
-                t.text(5)};
+                t.text(5),
+                t.real(6)};
     c.points[row.point] = row.settings;
     c.tasks.push_back(std::move(row));
   }
@@ -191,6 +196,61 @@ void keyResultsTable(std::ostream& body, const CampaignData& c,
   summary.files.push_back("key-results.csv");
 }
 
+// The core time of each point's completed runs (wall time times threads), in seconds.
+std::map<int, campaign::Summary> coreSeconds(const CampaignData& c) {
+  std::map<int, std::vector<double>> at;
+  for (const TaskRow& t : c.tasks) {
+    if (t.status == "completed") at[t.point].push_back(t.core_seconds);
+  }
+  std::map<int, campaign::Summary> out;
+  for (const auto& [point, values] : at) out[point] = campaign::summarize(values);
+  return out;
+}
+
+// The seeds whose mean has a 95% interval within `fraction` of it, for a result of this
+// relative scatter (std / |mean|, as one point's seeds estimate it): the least n >= 2 with
+// t(0.975, n - 1) cv / sqrt(n) <= fraction. 0 past 100,000.
+std::size_t seedsFor(double cv, double fraction) {
+  for (std::size_t n = 2; n <= 100000; ++n) {
+    if (campaign::studentT975(static_cast<double>(n - 1)) * cv / std::sqrt(double(n)) <= fraction)
+      return n;
+  }
+  return 0;
+}
+
+// What a mean costs at each point: a size study's smaller sample is quicker per run but may
+// scatter more, so it needs more seeds for the same interval. For each point and key result,
+// the scatter of one sample, the seeds for a 95% interval of +-5% of the mean, and the core
+// time they take at the point's mean run.
+void costTable(std::ostream& body, const CampaignData& c, const std::vector<std::string>& keys) {
+  const auto cost = coreSeconds(c);
+  if (cost.empty()) return;
+  body << "<h2>What a mean costs</h2>\n<p>Each point's core time per run (wall time times "
+          "threads, mean over its completed runs), and for each key result the scatter of one "
+          "sample (standard deviation over the mean), the seeds whose mean has a 95% interval "
+          "of &plusmn;5% of the mean at that scatter (Student t), and their core time. The "
+          "scatter is estimated from this campaign's seeds, so the seeds needed are as "
+          "uncertain as it.</p>\n<table><tr><th>point</th><th>core time per run (s)</th>"
+          "<th>key result</th><th>scatter</th><th>seeds for &plusmn;5%</th><th>their core "
+          "time (h)</th></tr>\n";
+  for (const auto& [point, settings] : c.points) {
+    const auto run = cost.find(point);
+    if (run == cost.end()) continue;
+    for (const std::string& key : keys) {
+      const auto it = c.statistics.find({point, key});
+      if (it == c.statistics.end() || it->second.n < 2 || it->second.mean == 0.0) continue;
+      const double cv = it->second.std / std::abs(it->second.mean);
+      const std::size_t n = seedsFor(cv, 0.05);
+      body << "<tr><td>" << point << " <code>" << html(settings) << "</code></td><td class=\"n\">"
+           << std::lround(run->second.mean) << "</td><td>" << html(key) << "</td><td class=\"n\">"
+           << num(cv, 2) << "</td><td class=\"n\">" << (n ? std::to_string(n) : "&gt; 100000")
+           << "</td><td class=\"n\">"
+           << (n ? num(double(n) * run->second.mean / 3600.0, 2) : "&ndash;") << "</td></tr>\n";
+    }
+  }
+  body << "</table>\n";
+}
+
 // A campaign over one numeric key (a size study over sample.count, a rate study): each key
 // result's mean with its 95% interval against that key's value, so that a reader sees where
 // a result converges and where a smaller sample sits on the curve. None for other campaigns.
@@ -216,7 +276,7 @@ std::optional<Figure> sweepFigure(const CampaignData& c, const std::vector<std::
   f.caption =
       "Each point's mean over its seeds with its 95% confidence interval (Student t), "
       "against " +
-      swept + ".";
+      swept + "; last, what a run of each point costs in core time.";
   for (const std::string& key : keys) {
     Series s;
     s.label = "mean, 95% CI";
@@ -237,6 +297,21 @@ std::optional<Figure> sweepFigure(const CampaignData& c, const std::vector<std::
         {swept, key + (unit.empty() || unit == "-" ? "" : " (" + unit + ")"), {std::move(s)}});
   }
   if (f.panels.empty()) return std::nullopt;
+  // What each point's accuracy costs: its runs' core time.
+  const auto cost = coreSeconds(c);
+  Series s;
+  s.label = "mean, 95% CI";
+  s.markers = true;
+  for (const auto& [x, point] : at) {
+    const auto it = cost.find(point);
+    if (it == cost.end()) continue;
+    const campaign::Summary& r = it->second;
+    s.x.push_back(x);
+    s.y.push_back(r.mean);
+    s.low.push_back(r.n > 1 ? r.low : r.mean);
+    s.high.push_back(r.n > 1 ? r.high : r.mean);
+  }
+  if (!s.x.empty()) f.panels.push_back({swept, "core time per run (s)", {std::move(s)}});
   return f;
 }
 
@@ -363,6 +438,7 @@ ReportSummary writeCampaignReport(const CampaignReportOptions& o) {
     body << "<h2>Against the sweep</h2>\n";
     writeFigure(*sweep, o.out, body, summary);
   }
+  costTable(body, c, keyResultNames(any));
   body << "<h2>Figures</h2>\n";
   std::vector<PointFigures> by_point;
   for (const auto& [point, point_runs] : runs) {

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "lab/campaign/statistics.hpp"
 #include "tests/e2e/protocol_support.hpp"
 
 namespace rocklab::testing {
@@ -126,6 +127,46 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
     EXPECT_NEAR(std::stod(m[1].str()), mean, 1e-8 * std::abs(mean));
     EXPECT_NEAR(std::stod(m[2].str()), low, 1e-8 * std::abs(mean));
     EXPECT_NEAR(std::stod(m[3].str()), high, 1e-8 * std::abs(mean));
+  }
+  // Last against the sweep, what a run of each point cost: the mean core time of its runs.
+  {
+    const auto cost = rows(lab.path,
+                           "SELECT avg(r.wall_seconds * max(r.threads, 1)) FROM runs r JOIN "
+                           "campaign_points p ON p.run_id = r.id WHERE p.point = 1");
+    ASSERT_EQ(cost.size(), 1u);
+    int last = 0;
+    std::istringstream lines(sweep);
+    for (std::string line; std::getline(lines, line);) {
+      if (!line.empty() && std::isdigit(static_cast<unsigned char>(line[0])))
+        last = std::max(last, std::stoi(line));
+    }
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        sweep, m,
+        std::regex("\n" + std::to_string(last) + ",mean  95% CI,0.5,([^,]+),[^,]+,[^,\n]+")))
+        << sweep;
+    EXPECT_NEAR(std::stod(m[1].str()), std::stod(cost[0]), 1e-6 * std::stod(cost[0]));
+  }
+  // What a mean costs: for each point and key result, the seeds whose 95% interval is +-5% of
+  // the mean at the point's scatter (the least n with t(0.975, n - 1) cv / sqrt(n) <= 0.05).
+  {
+    const auto stat = rows(lab.path,
+                           "SELECT std / abs(mean) FROM campaign_statistics s JOIN "
+                           "campaign_points p ON p.campaign_id = s.campaign_id AND p.point = "
+                           "s.point WHERE p.point = 1 AND s.name = 'secant_bulk_modulus_MPa' "
+                           "LIMIT 1");
+    ASSERT_EQ(stat.size(), 1u);
+    const double cv = std::stod(stat[0]);
+    std::size_t n = 2;
+    while (campaign::studentT975(double(n - 1)) * cv / std::sqrt(double(n)) > 0.05) ++n;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        page, m,
+        std::regex("<tr><td>1 <code>material.friction=0.5</code></td><td class=\"n\">[0-9]+</td>"
+                   "<td>secant_bulk_modulus_MPa</td><td class=\"n\">[^<]+</td><td "
+                   "class=\"n\">([0-9]+)</td>")))
+        << page;
+    EXPECT_EQ(m[1].str(), std::to_string(n));
   }
   // The points compared: each point's curves, as its own figure drew them, in one figure.
   std::size_t compared = 0;
