@@ -1,6 +1,7 @@
 #include "reports/campaign_report.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -251,67 +252,140 @@ void costTable(std::ostream& body, const CampaignData& c, const std::vector<std:
   body << "</table>\n";
 }
 
-// A campaign over one numeric key (a size study over sample.count, a rate study): each key
-// result's mean with its 95% interval against that key's value, so that a reader sees where
-// a result converges and where a smaller sample sits on the curve. None for other campaigns.
-std::optional<Figure> sweepFigure(const CampaignData& c, const std::vector<std::string>& keys) {
-  std::string swept;
-  std::vector<std::pair<double, int>> at;  // the key's value, its point
-  for (const auto& [point, settings] : c.points) {
-    const auto eq = settings.find('=');
-    if (eq == std::string::npos || settings.find(", ") != std::string::npos) return std::nullopt;
-    const std::string key = settings.substr(0, eq);
-    if (!swept.empty() && key != swept) return std::nullopt;
-    swept = key;
+// A point's settings ("k1=v1, k2=v2") as numbers by key; none when a value is not a number.
+std::optional<std::map<std::string, double>> numericSettings(const std::string& settings) {
+  std::map<std::string, double> out;
+  std::size_t from = 0;
+  while (from < settings.size()) {
+    std::size_t to = settings.find(", ", from);
+    if (to == std::string::npos) to = settings.size();
+    const std::string one = settings.substr(from, to - from);
+    const auto eq = one.find('=');
+    if (eq == std::string::npos) return std::nullopt;
     char* end = nullptr;
-    const double x = std::strtod(settings.c_str() + eq + 1, &end);
-    if (end == settings.c_str() + eq + 1 || *end != '\0') return std::nullopt;
-    at.emplace_back(x, point);
+    const double x = std::strtod(one.c_str() + eq + 1, &end);
+    if (end == one.c_str() + eq + 1 || *end != '\0') return std::nullopt;
+    out[one.substr(0, eq)] = x;
+    from = to + 2;
   }
-  if (at.size() < 2) return std::nullopt;
-  std::sort(at.begin(), at.end());
+  return out;
+}
+
+// The curves of a sweep figure: one per value of the second swept key (one in all over a
+// single key), each its points in the order of the key along x.
+struct SweepCurves {
+  std::string x_key;
+  bool log_x = false;
+  std::vector<std::pair<std::string, std::vector<std::pair<double, int>>>> curves;
+};
+
+// Over one numeric key, or two (a size study at several rates, a rate check at several
+// sizes): x is the key with the more values (the later on a tie), one curve per value of the
+// other. None when the points sweep other keys or values that are not numbers.
+std::optional<SweepCurves> sweepCurves(const CampaignData& c) {
+  std::vector<std::string> keys;
+  std::vector<std::pair<std::map<std::string, double>, int>> points;
+  for (const auto& [point, settings] : c.points) {
+    const auto values = numericSettings(settings);
+    if (!values || values->empty() || values->size() > 2) return std::nullopt;
+    std::vector<std::string> these;
+    for (const auto& kv : *values) these.push_back(kv.first);
+    if (keys.empty()) keys = these;
+    if (these != keys) return std::nullopt;
+    points.emplace_back(*values, point);
+  }
+  if (points.size() < 2) return std::nullopt;
+  // The keys in the campaign's order (the settings name them so), not the map's.
+  const std::string& first = c.points.begin()->second;
+  if (keys.size() == 2 && first.find(keys[1] + "=") < first.find(keys[0] + "="))
+    std::swap(keys[0], keys[1]);
+  const auto distinct = [&](const std::string& key) {
+    std::set<double> v;
+    for (const auto& [values, point] : points) v.insert(values.at(key));
+    return v;
+  };
+  SweepCurves s;
+  s.x_key = keys.back();
+  if (keys.size() == 2 && distinct(keys[0]).size() > distinct(keys[1]).size()) s.x_key = keys[0];
+  const std::set<double> xs = distinct(s.x_key);
+  // A rate halved at each point spans decades: its points are evenly apart on a log axis.
+  s.log_x = *xs.begin() > 0.0 && *xs.rbegin() / *xs.begin() > 10.0;
+  std::map<double, std::vector<std::pair<double, int>>> by_group;
+  std::string group_key;
+  for (const auto& k : keys) {
+    if (k != s.x_key) group_key = k;
+  }
+  for (const auto& [values, point] : points) {
+    by_group[group_key.empty() ? 0.0 : values.at(group_key)].emplace_back(values.at(s.x_key),
+                                                                          point);
+  }
+  for (auto& [g, at] : by_group) {
+    std::sort(at.begin(), at.end());
+    std::ostringstream label;
+    if (group_key.empty()) {
+      label << "mean, 95% CI";
+    } else {
+      label << group_key << "=" << g;
+    }
+    s.curves.emplace_back(label.str(), std::move(at));
+  }
+  return s;
+}
+
+// A campaign over one or two numeric keys (a size study over sample.count, a rate study): each
+// key result's mean with its 95% interval against the key, so that a reader sees where a
+// result converges and where a smaller sample sits on the curve, and last what a run of each
+// point costs. None for other campaigns.
+std::optional<Figure> sweepFigure(const CampaignData& c, const std::vector<std::string>& keys) {
+  const auto sweep = sweepCurves(c);
+  if (!sweep) return std::nullopt;
   Figure f;
   f.id = "sweep";
-  f.title = "Key results against " + swept;
+  f.title = "Key results against " + sweep->x_key;
   f.caption =
       "Each point's mean over its seeds with its 95% confidence interval (Student t), "
       "against " +
-      swept + "; last, what a run of each point costs in core time.";
-  for (const std::string& key : keys) {
-    Series s;
-    s.label = "mean, 95% CI";
-    s.markers = true;
-    std::string unit;
-    for (const auto& [x, point] : at) {
-      auto it = c.statistics.find({point, key});
-      if (it == c.statistics.end()) continue;
-      const StatisticRow& r = it->second;
-      s.x.push_back(x);
-      s.y.push_back(r.mean);
-      s.low.push_back(r.low.value_or(r.mean));
-      s.high.push_back(r.high.value_or(r.mean));
-      unit = r.unit;
+      sweep->x_key + (sweep->log_x ? " (log scale)" : "") +
+      (sweep->curves.size() > 1 ? ", one curve per value of the other swept key" : "") +
+      "; last, what a run of each point costs in core time.";
+  const auto cost = coreSeconds(c);
+  const auto panel = [&](const std::string& y_label, const auto& at_point) {
+    Panel p{sweep->x_key, y_label, {}, sweep->log_x};
+    for (const auto& [label, at] : sweep->curves) {
+      Series s;
+      s.label = label;
+      s.markers = sweep->curves.size() == 1;
+      for (const auto& [x, point] : at) {
+        const std::optional<std::array<double, 3>> v = at_point(point);
+        if (!v) continue;
+        s.x.push_back(x);
+        s.y.push_back((*v)[0]);
+        s.low.push_back((*v)[1]);
+        s.high.push_back((*v)[2]);
+      }
+      if (!s.x.empty()) p.series.push_back(std::move(s));
     }
-    if (s.x.empty()) continue;
-    f.panels.push_back(
-        {swept, key + (unit.empty() || unit == "-" ? "" : " (" + unit + ")"), {std::move(s)}});
+    if (!p.series.empty()) f.panels.push_back(std::move(p));
+  };
+  for (const std::string& key : keys) {
+    std::string unit;
+    panel(key, [&](int point) -> std::optional<std::array<double, 3>> {
+      const auto it = c.statistics.find({point, key});
+      if (it == c.statistics.end()) return std::nullopt;
+      const StatisticRow& r = it->second;
+      unit = r.unit;
+      return std::array<double, 3>{r.mean, r.low.value_or(r.mean), r.high.value_or(r.mean)};
+    });
+    if (!f.panels.empty() && f.panels.back().y_label == key && !unit.empty() && unit != "-")
+      f.panels.back().y_label += " (" + unit + ")";
   }
   if (f.panels.empty()) return std::nullopt;
-  // What each point's accuracy costs: its runs' core time.
-  const auto cost = coreSeconds(c);
-  Series s;
-  s.label = "mean, 95% CI";
-  s.markers = true;
-  for (const auto& [x, point] : at) {
+  panel("core time per run (s)", [&](int point) -> std::optional<std::array<double, 3>> {
     const auto it = cost.find(point);
-    if (it == cost.end()) continue;
+    if (it == cost.end()) return std::nullopt;
     const campaign::Summary& r = it->second;
-    s.x.push_back(x);
-    s.y.push_back(r.mean);
-    s.low.push_back(r.n > 1 ? r.low : r.mean);
-    s.high.push_back(r.n > 1 ? r.high : r.mean);
-  }
-  if (!s.x.empty()) f.panels.push_back({swept, "core time per run (s)", {std::move(s)}});
+    return std::array<double, 3>{r.mean, r.n > 1 ? r.low : r.mean, r.n > 1 ? r.high : r.mean};
+  });
   return f;
 }
 

@@ -146,9 +146,16 @@ void renderFigure(const Figure& f, const std::string& dir) {
       }
     }
     for (int a = 0; a < 2 && hi[0] >= lo[0]; ++a) {
-      const double pad = hi[a] > lo[a] ? 0.05 * (hi[a] - lo[a]) : 0.5 * std::abs(hi[a]) + 1.0;
       vtkAxis* axis = chart->GetAxis(a == 0 ? vtkAxis::BOTTOM : vtkAxis::LEFT);
       axis->SetBehavior(vtkAxis::FIXED);
+      if (a == 0 && panel.log_x && lo[0] > 0.0) {
+        // The same 5% margin, of the decades.
+        const double pad = hi[0] > lo[0] ? std::pow(hi[0] / lo[0], 0.05) : 2.0;
+        axis->SetLogScale(true);
+        axis->SetUnscaledRange(lo[0] / pad, hi[0] * pad);
+        continue;
+      }
+      const double pad = hi[a] > lo[a] ? 0.05 * (hi[a] - lo[a]) : 0.5 * std::abs(hi[a]) + 1.0;
       axis->SetRange(lo[a] - pad, hi[a] + pad);
     }
     for (std::size_t k = 0; k < panel.series.size(); ++k) {

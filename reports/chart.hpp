@@ -19,6 +19,7 @@ struct Series {
 struct Panel {
   std::string x_label, y_label;
   std::vector<Series> series;
+  bool log_x = false;  // x on a log scale (every x positive): a rate halved at each point
 };
 
 struct Figure {

@@ -270,6 +270,42 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
   EXPECT_NE(out.find("0 runs merged into " + other.path + ", 4 there already"), std::string::npos)
       << out;
   EXPECT_EQ(rows(other.path, "SELECT count(*) FROM runs"), std::vector<std::string>{"4|"});
+  // Over two numeric keys the sweep figure draws one curve per value of one against the
+  // other (the later on a tie): the friction's points at 200 particles are those above.
+  {
+    const std::string both = campaignFile(lab.path, "friction-size", R"(seeds = 2
+[sweep]
+"material.friction" = [0.3, 0.5]
+"sample.count" = [150, 200]
+)");
+    ASSERT_EQ(runRocklab("campaign run " + both + " --jobs 2 --quiet --lab " + lab.path, &out), 0)
+        << out;
+    EXPECT_NE(out.find("4 of 8 runs to do"), std::string::npos) << out;
+    const std::string two = lab.path + ".report-two";
+    ASSERT_EQ(runRocklab("campaign report " + both + " --lab " + lab.path + " --out " + two, &out),
+              0)
+        << out;
+    std::ifstream in(two + "/sweep.csv");
+    const std::string curves(std::istreambuf_iterator<char>(in), {});
+    for (const char* friction : {"0.3", "0.5"}) {
+      for (const char* count : {"150", "200"}) {
+        EXPECT_NE(curves.find(std::string(",material.friction=") + friction + "," + count + ","),
+                  std::string::npos)
+            << curves;
+      }
+    }
+    const auto stat = rows(lab.path,
+                           "SELECT s.mean FROM campaign_statistics s JOIN campaigns c ON c.id = "
+                           "s.campaign_id WHERE c.name = 'friction' AND s.point = 1 AND s.name = "
+                           "'secant_bulk_modulus_MPa'");
+    ASSERT_EQ(stat.size(), 1u);
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(curves, m, std::regex("\n3,material.friction=0.5,200,([^,]+),")))
+        << curves;
+    EXPECT_NEAR(std::stod(m[1].str()), std::stod(stat[0]), 1e-8 * std::abs(std::stod(stat[0])));
+    fs::remove_all(two);
+    fs::remove(both);
+  }
   fs::remove(file);
   removeLabFiles(lab);
   removeLabFiles(by_hand);
