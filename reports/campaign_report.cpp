@@ -252,9 +252,11 @@ void costTable(std::ostream& body, const CampaignData& c, const std::vector<std:
   body << "</table>\n";
 }
 
-// A point's settings ("k1=v1, k2=v2") as numbers by key; none when a value is not a number.
-std::optional<std::map<std::string, double>> numericSettings(const std::string& settings) {
-  std::map<std::string, double> out;
+// A point's settings ("k1=v1, k2=v2") as numbers, in the campaign's order of the keys; none
+// when a value is not a number.
+using Numbers = std::vector<std::pair<std::string, double>>;
+std::optional<Numbers> numericSettings(const std::string& settings) {
+  Numbers out;
   std::size_t from = 0;
   while (from < settings.size()) {
     std::size_t to = settings.find(", ", from);
@@ -265,7 +267,7 @@ std::optional<std::map<std::string, double>> numericSettings(const std::string& 
     char* end = nullptr;
     const double x = std::strtod(one.c_str() + eq + 1, &end);
     if (end == one.c_str() + eq + 1 || *end != '\0') return std::nullopt;
-    out[one.substr(0, eq)] = x;
+    out.emplace_back(one.substr(0, eq), x);
     from = to + 2;
   }
   return out;
@@ -283,49 +285,43 @@ struct SweepCurves {
 // sizes): x is the key with the more values (the later on a tie), one curve per value of the
 // other. None when the points sweep other keys or values that are not numbers.
 std::optional<SweepCurves> sweepCurves(const CampaignData& c) {
-  std::vector<std::string> keys;
-  std::vector<std::pair<std::map<std::string, double>, int>> points;
+  std::vector<std::pair<Numbers, int>> points;
   for (const auto& [point, settings] : c.points) {
-    const auto values = numericSettings(settings);
+    auto values = numericSettings(settings);
     if (!values || values->empty() || values->size() > 2) return std::nullopt;
-    std::vector<std::string> these;
-    for (const auto& kv : *values) these.push_back(kv.first);
-    if (keys.empty()) keys = these;
-    if (these != keys) return std::nullopt;
-    points.emplace_back(*values, point);
+    if (!points.empty()) {
+      const Numbers& first = points.front().first;
+      if (values->size() != first.size()) return std::nullopt;
+      for (std::size_t k = 0; k < first.size(); ++k) {
+        if ((*values)[k].first != first[k].first) return std::nullopt;
+      }
+    }
+    points.emplace_back(std::move(*values), point);
   }
   if (points.size() < 2) return std::nullopt;
-  // The keys in the campaign's order (the settings name them so), not the map's.
-  const std::string& first = c.points.begin()->second;
-  if (keys.size() == 2 && first.find(keys[1] + "=") < first.find(keys[0] + "="))
-    std::swap(keys[0], keys[1]);
-  const auto distinct = [&](const std::string& key) {
+  const std::size_t keys = points.front().first.size();
+  const auto distinct = [&](std::size_t k) {
     std::set<double> v;
-    for (const auto& [values, point] : points) v.insert(values.at(key));
+    for (const auto& [values, point] : points) v.insert(values[k].second);
     return v;
   };
+  const std::size_t x = keys == 2 && distinct(0).size() > distinct(1).size() ? 0 : keys - 1;
   SweepCurves s;
-  s.x_key = keys.back();
-  if (keys.size() == 2 && distinct(keys[0]).size() > distinct(keys[1]).size()) s.x_key = keys[0];
-  const std::set<double> xs = distinct(s.x_key);
+  s.x_key = points.front().first[x].first;
+  const std::set<double> xs = distinct(x);
   // A rate halved at each point spans decades: its points are evenly apart on a log axis.
   s.log_x = *xs.begin() > 0.0 && *xs.rbegin() / *xs.begin() > 10.0;
-  std::map<double, std::vector<std::pair<double, int>>> by_group;
-  std::string group_key;
-  for (const auto& k : keys) {
-    if (k != s.x_key) group_key = k;
-  }
+  std::map<double, std::vector<std::pair<double, int>>> by_group;  // the other key's value
   for (const auto& [values, point] : points) {
-    by_group[group_key.empty() ? 0.0 : values.at(group_key)].emplace_back(values.at(s.x_key),
-                                                                          point);
+    by_group[keys == 2 ? values[1 - x].second : 0.0].emplace_back(values[x].second, point);
   }
   for (auto& [g, at] : by_group) {
     std::sort(at.begin(), at.end());
     std::ostringstream label;
-    if (group_key.empty()) {
-      label << "mean, 95% CI";
+    if (keys == 2) {
+      label << points.front().first[1 - x].first << "=" << g;
     } else {
-      label << group_key << "=" << g;
+      label << "mean, 95% CI";
     }
     s.curves.emplace_back(label.str(), std::move(at));
   }
