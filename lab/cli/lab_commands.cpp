@@ -108,7 +108,7 @@ void writeWhole(const std::string& path, const std::string& text) {
   std::filesystem::rename(tmp, path);
 }
 
-int checkProtocol(const std::string& path, const std::vector<std::string>& sets) {
+int checkProtocol(const std::string& path, const std::vector<std::string>& sets, bool print) {
   try {
     const auto c = rigs::checkProtocol(path, overridesOf(sets));
     std::size_t given = 0, total = 0;
@@ -117,6 +117,11 @@ int checkProtocol(const std::string& path, const std::vector<std::string>& sets)
       given += c.settings.given(row.key);
     }
     for (const std::string& w : rigs::unusedKeys(c.settings)) std::cerr << "warning: " << w << "\n";
+    if (print) {
+      std::cout << c.settings.effectiveText();
+      std::cerr << path << ": a valid " << c.rig->name << " protocol\n";
+      return 0;
+    }
     std::cout << path << ": a valid " << c.rig->name << " protocol (" << given << " keys set, "
               << total - given << " defaults)\n";
     return 0;

@@ -19,7 +19,8 @@ struct RunOptions {
 
 // Returns the process exit code: 0 completed, 1 failed, 2 invalid protocol, 130 interrupted.
 int runProtocol(const RunOptions& o);
-int checkProtocol(const std::string& path, const std::vector<std::string>& sets);
+int checkProtocol(const std::string& path, const std::vector<std::string>& sets,
+                  bool print = false);
 // `rocklab rerun`: a run of the notebook run again from its effective protocol text alone,
 // into the same notebook as a new run.
 int rerunProtocol(std::int64_t run, const RunOptions& o);

@@ -275,8 +275,12 @@ void addCheckAndKeys(CLI::App& app, Action& action) {
   auto* c = app.add_subcommand("check", "Validate a protocol without running it");
   c->add_option("protocol", *file, "Protocol file (TOML)")->required();
   addSet(c, *sets);
-  c->callback([&action, file, sets] {
-    action = [file, sets] { return rocklab::cli::checkProtocol(*file, *sets); };
+  auto print = std::make_shared<bool>(false);
+  c->add_flag("--print", *print,
+              "Print the protocol as it would run: with its includes, base and --set values "
+              "written in, as the notebook keeps it");
+  c->callback([&action, file, sets, print] {
+    action = [file, sets, print] { return rocklab::cli::checkProtocol(*file, *sets, *print); };
   });
 
   auto rig = std::make_shared<std::string>();

@@ -247,14 +247,49 @@ TomlValue parseToml(const std::string& file, const std::string& text) {
 
 }  // namespace
 
-std::string rigOf(const std::string& file, const std::string& text) {
+namespace {
+
+constexpr const char* kBase = "base";
+// A chain of bases longer than this is taken for a cycle (a protocol based on itself).
+constexpr int kMaxBases = 16;
+
+// The file a protocol's top-level `base` names, resolved against the protocol's folder;
+// empty when it names none; throws when `base` is not a text.
+std::string baseFile(const std::string& file, const TomlValue& root) {
+  if (!root.contains(kBase)) return "";
+  const TomlValue& v = root.at(kBase);
+  if (!v.is_string()) {
+    throw ProtocolError({file + ":" + std::to_string(v.location().line()) + ": " + kBase +
+                         " expects the file of the protocol this one varies, e.g. base = "
+                         "\"biaxial-ucs.toml\" (relative to the protocol's folder)"});
+  }
+  const std::filesystem::path p(v.as_string().str);
+  const std::filesystem::path folder = std::filesystem::path(file).parent_path();
+  return (p.is_absolute() ? p : folder / p).lexically_normal().string();
+}
+
+std::string rigOf(const std::string& file, const std::string& text, int depth) {
   const TomlValue root = parseToml(file, text);
-  if (!root.contains("protocol") || !root.at("protocol").is_table() ||
-      !root.at("protocol").contains("rig") || !root.at("protocol").at("rig").is_string()) {
+  if (root.contains("protocol") && root.at("protocol").is_table() &&
+      root.at("protocol").contains("rig") && root.at("protocol").at("rig").is_string()) {
+    return root.at("protocol").at("rig").as_string().str;
+  }
+  const std::string base = baseFile(file, root);
+  if (base.empty()) {
     throw ProtocolError({file + ": missing key 'protocol.rig' (text): the rig that runs the "
                                 "protocol, e.g. rig = \"oedometer\""});
   }
-  return root.at("protocol").at("rig").as_string().str;
+  if (depth >= kMaxBases) {
+    throw ProtocolError({file + ": " + kBase + ": more than " + std::to_string(kMaxBases) +
+                         " bases in a chain (does a protocol name itself as its base?)"});
+  }
+  return rigOf(base, readFile(base), depth + 1);
+}
+
+}  // namespace
+
+std::string rigOf(const std::string& file, const std::string& text) {
+  return rigOf(file, text, 0);
 }
 
 namespace {
@@ -486,6 +521,43 @@ std::vector<std::pair<std::string, Place>> includedFiles(const std::string& file
   return files;
 }
 
+// The bases being parsed, innermost last: a protocol met again is a cycle.
+thread_local std::vector<std::string> t_bases;
+
+// The protocol `root` names as its base (with its own includes and base), parsed; none when
+// it names none or has problems (added to `problems` at the `base` line).
+std::optional<Settings> readBase(const std::string& file, const TomlValue& root,
+                                 const Schema& schema, Problems& problems) {
+  if (!root.contains(kBase)) return std::nullopt;
+  const int line = static_cast<int>(root.at(kBase).location().line());
+  const Place place{line, file + ":" + std::to_string(line)};
+  std::string path;
+  try {
+    path = baseFile(file, root);
+  } catch (const ProtocolError& e) {
+    for (const auto& p : e.problems()) problems.at(place, p.substr(p.find(": ") + 2));
+    return std::nullopt;
+  }
+  std::error_code ec;
+  const std::string id = std::filesystem::weakly_canonical(path, ec).string();
+  if (std::find(t_bases.begin(), t_bases.end(), id) != t_bases.end() ||
+      t_bases.size() >= static_cast<std::size_t>(kMaxBases)) {
+    problems.at(place, std::string(kBase) + ": " + path +
+                           " is already a base of this protocol (a cycle of bases)");
+    return std::nullopt;
+  }
+  t_bases.push_back(id);
+  try {
+    Settings base = parseProtocol(path, readFile(path), schema);
+    t_bases.pop_back();
+    return base;
+  } catch (const ProtocolError& e) {
+    t_bases.pop_back();
+    for (const auto& p : e.problems()) problems.at(place, std::string(kBase) + ": " + p);
+    return std::nullopt;
+  }
+}
+
 }  // namespace
 
 Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema,
@@ -501,7 +573,7 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
   auto walk = [&](auto&& self, const TomlValue& table, const std::string& prefix,
                   const std::string& from, int order) -> void {
     for (const auto& [k, v] : table.as_table()) {
-      if (prefix.empty() && k == kInclude) continue;
+      if (prefix.empty() && (k == kInclude || k == kBase)) continue;
       const std::string key = prefix.empty() ? k : prefix + "." + k;
       const int line = static_cast<int>(v.location().line());
       if (v.is_table()) {
@@ -548,6 +620,29 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
     }
     s.includes_.push_back(path);
     walk(walk, inc, "", path, order);
+  }
+  // The base's keys that neither the file nor its includes give: a variant of a protocol
+  // (its quick twin: the same material and loading on fewer particles) gives only what
+  // differs. A relative path given in the base stays relative to the base's folder.
+  if (const std::optional<Settings> base = readBase(file, root, schema, problems)) {
+    const auto folder = std::filesystem::absolute(std::filesystem::path(file).parent_path());
+    for (const auto& [key, line] : base->given_) {
+      if (s.given_.count(key)) continue;
+      Value v = base->values_.at(key);
+      const auto* text = std::get_if<std::string>(&v);
+      if (text && !text->empty() && !std::filesystem::path(*text).is_absolute() &&
+          schema.find(key)->unit.name == units::path.name) {
+        v = std::filesystem::absolute(base->path(key))
+                .lexically_normal()
+                .lexically_relative(folder.lexically_normal())
+                .string();
+      }
+      s.given_[key] = line;
+      s.given_in_[key] = base->given_in_.count(key) ? base->given_in_.at(key) : base->file_;
+      s.values_[key] = std::move(v);
+    }
+    s.base_ = base->file_;
+    for (const std::string& inc : base->includes_) s.includes_.push_back(inc);
   }
   applyOverrides(schema, overrides, s.values_, s.given_, s.overrides_, problems);
   for (const ParamDecl& d : schema.all()) {
@@ -655,10 +750,10 @@ std::string editedText(const std::string& source,
 }  // namespace
 
 std::string Settings::effectiveText() const {
-  if (overrides_.empty() && includes_.empty()) return source_;
+  if (overrides_.empty() && includes_.empty() && base_.empty()) return source_;
   std::map<std::string, Value> values = values_;  // as given: the run's choices left out
   for (const auto& [key, v] : unchosen_) values[key] = v;
-  std::string with;
+  std::string with = base_.empty() ? "" : "base " + base_;
   for (const std::string& inc : includes_) with += (with.empty() ? "" : ", ") + ("include " + inc);
   std::vector<std::tuple<std::string, int, std::string>> edits;
   for (const auto& [key, o] : overrides_) {
@@ -675,7 +770,7 @@ std::string Settings::effectiveText() const {
   // The edited file reads back to these settings, or (an override inside a multi-line value
   // or a table the file defines by dotted keys; an included file, whose keys must be in the
   // text for it to stand alone) every key is written out, table by table.
-  std::string text = includes_.empty() ? editedText(source_, edits) : std::string();
+  std::string text = includes_.empty() && base_.empty() ? editedText(source_, edits) : "";
   auto readsBack = [&](const std::string& t) {
     try {
       const Settings back = parseProtocol(file_, t, *schema_);

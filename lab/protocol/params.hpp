@@ -116,12 +116,15 @@ class Settings {
   const ParamDecl& decl(const std::string& key) const;  // throws std::logic_error if undeclared
   // The protocol file's text as read.
   const std::string& source() const { return source_; }
-  // The files its `include` names (a material's keys), as paths from the working folder.
+  // The files its `include` names (a material's keys), as paths from the working folder,
+  // then its base's.
   const std::vector<std::string>& includes() const { return includes_; }
+  // The protocol its `base` names (this one gives only what differs from it), or "".
+  const std::string& base() const { return base_; }
   // The protocol as run: the file's text when nothing was overridden or included, else the
   // text with each override written in and marked ("# --set ..."), or, when it includes
-  // files, every key written out: parsing it alone gives these settings (the notebook keeps
-  // it; `rocklab rerun` runs it again; a changed material file changes its hash).
+  // files or has a base, every key written out: parsing it alone gives these settings (the notebook
+  // keeps it; `rocklab rerun` runs it again; a changed material file changes its hash).
   std::string effectiveText() const;
   // What the run is, whatever the text says it with: every key away from its default (given
   // by the file, its includes or an override), with its value, in the schema's order.
@@ -138,6 +141,7 @@ class Settings {
   std::string file_, source_;
   std::map<std::string, Value> values_;
   std::vector<std::string> includes_;
+  std::string base_;
   std::map<std::string, int> given_;             // key -> line (0: given by an override)
   std::map<std::string, std::string> given_in_;  // key -> the included file that gave it
   std::map<std::string, Override> overrides_;    // key -> the override that set it last
@@ -149,8 +153,10 @@ class Settings {
 // values out of range) each naming the file, line, key, allowed range and unit. A top-level
 // `include = "materials/NAME.toml"` (or a list of them; relative to `file`'s folder) adds
 // the keys of those files, checked the same way at their own lines; a key is given once,
-// in the protocol or in one included file. Overrides replace or add keys after the files',
-// validated the same way.
+// in the protocol or in one included file. A top-level `base = "OTHER.toml"` (relative to
+// `file`'s folder) takes every key of that protocol (with its includes and base) that the
+// file and its includes do not give: a variant gives only what differs. Overrides replace or
+// add keys after the files', validated the same way.
 Settings parseProtocol(const std::string& file, const std::string& text, const Schema& schema,
                        const std::vector<Override>& overrides = {});
 

@@ -294,9 +294,9 @@ TEST(Cli, StudyAndRegressRefuseBadInputBeforeRunning) {
 TEST(Cli, ShippedProtocolsCheck) {
   namespace fs = std::filesystem;
   const fs::path source = ROCKLAB_SOURCE_DIR;
+  // A key's text as the protocol runs it (with its base and includes).
   const auto field = [](const fs::path& file, const std::string& key) {
-    std::ifstream in(file);
-    const std::string text((std::istreambuf_iterator<char>(in)), {});
+    const std::string text = run("check " + file.string() + " --print").out;
     std::smatch m;
     return std::regex_search(text, m, std::regex("\\n" + key + " = \"([^\"]+)\"")) ? m[1].str()
                                                                                    : std::string();

@@ -201,7 +201,8 @@ class CalibrationFile : public ::testing::Test {
             std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
-    for (const char* p : {"biaxial-ucs-quick.toml", "brazilian-2d-quick.toml"}) {
+    for (const char* p :
+         {"biaxial-ucs-quick.toml", "brazilian-2d-quick.toml", "brazilian-2d.toml"}) {
       fs::copy_file(fs::path(ROCKLAB_SOURCE_DIR) / "protocols" / p, dir_ / p);
     }
   }

@@ -27,6 +27,7 @@ struct Sample {
   bool quiet = false;
   std::vector<double> cycles;
   std::vector<std::string> key_results;
+  std::string file;
 
   template <class F>
   void fields(F& f) {
@@ -40,6 +41,7 @@ struct Sample {
     f.at("numerics.")(local_damping,
                       {"local_damping", units::none, Range::rightOpen(0, 1), "PFC local damping"});
     f.at("sample.")(count, {"count", units::none, Range::closed(2, 1e8), "particles"});
+    f.at("sample.")(file, {"file", units::path, {}, "a packing"});
     f.at("bonds.")(negative, {"negative_strength", units::text, {}, "draws <= 0"}, kNegative);
     f.at("output.")(quiet, {"quiet", units::text, {}, "no progress"});
     f.at("loading.")(cycles, {"cycle_at_axial_strain", units::none, Range::open(0, 1), "cycles"});
@@ -394,6 +396,83 @@ TEST_F(Included, AKeyIsGivenOnceAndABadIncludeIsNamedAtItsLine) {
       e.find(p + ":1: include: " + (dir_ / "materials/broken.toml").string() + ": not valid TOML"),
       std::string::npos)
       << e;
+}
+
+// A variant of a protocol (a quick twin) names it as its base and gives only what differs:
+// the base's keys, its includes' and its relative paths as the base reads them.
+TEST_F(Included, AVariantGivesOnlyWhatDiffersFromItsBase) {
+  const Schema sc = schema();
+  const std::string material = write("materials/soft.toml", kMaterial);
+  const std::string full =
+      write("full.toml", "include = \"materials/soft.toml\"\n" + std::string(kGood) +
+                             "[sample]\nfile = \"data/p.txt\"\n");
+  std::filesystem::create_directories(dir_ / "quick");
+  const std::string text =
+      "base = \"../full.toml\"\n[protocol]\nname = \"t-quick\"\n[sample]\ncount = 9\n";
+  const std::string file = write("quick/q.toml", text);
+  EXPECT_EQ(rigOf(file, text), "oedometer");
+  const Settings s = parseProtocol(file, text, sc);
+  EXPECT_EQ(s.text("protocol.name"), "t-quick");
+  EXPECT_EQ(s.integer("sample.count"), 9);
+  EXPECT_DOUBLE_EQ(s.real("numerics.local_damping"), 0.25);
+  EXPECT_DOUBLE_EQ(s.real("formation.axial_stress_MPa"), 30.0);
+  EXPECT_EQ(s.where("numerics.local_damping"), material + ":2");
+  EXPECT_EQ(s.where("formation.axial_stress_MPa"), full + ":8");
+  EXPECT_EQ(s.where("sample.count"), file + ":5");
+  EXPECT_EQ(std::filesystem::weakly_canonical(s.path("sample.file")), dir_ / "data/p.txt");
+  EXPECT_EQ(s.base(), full);
+  EXPECT_EQ(s.includes(), std::vector<std::string>{material});
+  // The same run as the base with the differences set on the command line (from the base's
+  // folder: the identity writes a path as given).
+  const std::string beside = "base = \"full.toml\"\n" + text.substr(text.find('\n') + 1);
+  EXPECT_EQ(parseProtocol(write("q.toml", beside), beside, sc).identity(),
+            parseProtocol(full, readFile(full), sc,
+                          {parseOverride("protocol.name=t-quick"), parseOverride("sample.count=9")})
+                .identity());
+  // The protocol as run stands alone, and the base's edits change it.
+  const std::string effective = s.effectiveText();
+  EXPECT_EQ(effective.find("base ="), std::string::npos) << effective;
+  EXPECT_NE(effective.find(" with base " + full), std::string::npos) << effective;
+  const Settings back = parseProtocol(file, effective, sc);
+  ASSERT_EQ(back.table().size(), s.table().size());
+  for (std::size_t k = 0; k < s.table().size(); ++k) {
+    EXPECT_EQ(back.table()[k].value, s.table()[k].value) << s.table()[k].key;
+  }
+  write("full.toml", "include = \"materials/soft.toml\"\n" + std::string(kGood) +
+                         "[sample]\nfile = \"data/q.txt\"\n");
+  EXPECT_NE(parseProtocol(file, text, sc).effectiveText(), effective);
+
+  auto problems = [&](const std::string& t) {
+    const std::string f = write("quick/q.toml", t);
+    try {
+      parseProtocol(f, t, sc);
+    } catch (const ProtocolError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  // Within the variant a key is still given once; its base's problems at their own lines.
+  EXPECT_NE(
+      problems("include = \"../materials/soft.toml\"\n" + text).find("sample.count is given again"),
+      std::string::npos);
+  write("bad.toml", "[protocol]\nname = \"b\"\nrig = \"oedometer\"\n[sample]\ncount = 1\n");
+  std::string e = problems("base = \"../bad.toml\"\n");
+  EXPECT_NE(e.find(file + ":1: base: " + (dir_ / "bad.toml").string() +
+                   ":5: sample.count = 1 is outside the allowed range"),
+            std::string::npos)
+      << e;
+  e = problems("base = \"../none.toml\"\n");
+  EXPECT_NE(e.find(file + ":1: base: " + (dir_ / "none.toml").string() + ": cannot read"),
+            std::string::npos)
+      << e;
+  e = problems("base = 3\n");
+  EXPECT_NE(e.find(file + ":1: base expects the file of the protocol this one varies"),
+            std::string::npos)
+      << e;
+  write("a.toml", "base = \"b.toml\"\n");
+  write("b.toml", "base = \"a.toml\"\n");
+  e = problems("base = \"../a.toml\"\n");
+  EXPECT_NE(e.find("a cycle of bases"), std::string::npos) << e;
 }
 
 // A section of two fields and a rule across them, as a rig's loading.
