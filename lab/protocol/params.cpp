@@ -625,7 +625,7 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
   // (its quick twin: the same material and loading on fewer particles) gives only what
   // differs. A relative path given in the base stays relative to the base's folder.
   if (const std::optional<Settings> base = readBase(file, root, schema, problems)) {
-    const auto folder = std::filesystem::absolute(std::filesystem::path(file).parent_path());
+    const auto folder = std::filesystem::absolute(file).parent_path();
     for (const auto& [key, line] : base->given_) {
       if (s.given_.count(key)) continue;
       Value v = base->values_.at(key);

@@ -422,6 +422,11 @@ TEST_F(Included, AVariantGivesOnlyWhatDiffersFromItsBase) {
   EXPECT_EQ(std::filesystem::weakly_canonical(s.path("sample.file")), dir_ / "data/p.txt");
   EXPECT_EQ(s.base(), full);
   EXPECT_EQ(s.includes(), std::vector<std::string>{material});
+  // Named from its own folder (a path without a folder).
+  const auto here = std::filesystem::current_path();
+  std::filesystem::current_path(dir_ / "quick");
+  EXPECT_EQ(parseProtocol("q.toml", text, sc).integer("sample.count"), 9);
+  std::filesystem::current_path(here);
   // The same run as the base with the differences set on the command line (from the base's
   // folder: the identity writes a path as given).
   const std::string beside = "base = \"full.toml\"\n" + text.substr(text.find('\n') + 1);
