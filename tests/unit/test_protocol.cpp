@@ -303,6 +303,24 @@ class Included : public ::testing::Test {
     std::ofstream(path) << text;
     return path;
   }
+  // The protocol as run, parsed alone as `file`, gives the same settings.
+  static void expectReadsBack(const std::string& file, const Settings& s) {
+    const Settings back = parseProtocol(file, s.effectiveText(), schema());
+    ASSERT_EQ(back.table().size(), s.table().size());
+    for (std::size_t k = 0; k < s.table().size(); ++k) {
+      EXPECT_EQ(back.table()[k].value, s.table()[k].value) << s.table()[k].key;
+    }
+  }
+  // The problems of `text` written as `name` and parsed, joined; "" when there are none.
+  std::string problems(const std::string& name, const std::string& text) {
+    const std::string file = write(name, text);
+    try {
+      parseProtocol(file, text, schema());
+    } catch (const ProtocolError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  }
   std::filesystem::path dir_;
 };
 
@@ -327,11 +345,7 @@ TEST_F(Included, AMaterialFilesKeysJoinTheProtocolsCheckedAtTheirOwnLines) {
   const std::string effective = s.effectiveText();
   EXPECT_EQ(effective.find("include ="), std::string::npos) << effective;
   EXPECT_NE(effective.find("count = 64  # " + material), std::string::npos) << effective;
-  const Settings back = parseProtocol(file, effective, sc);
-  EXPECT_EQ(back.table().size(), s.table().size());
-  for (std::size_t k = 0; k < s.table().size(); ++k) {
-    EXPECT_EQ(back.table()[k].value, s.table()[k].value) << s.table()[k].key;
-  }
+  expectReadsBack(file, s);
   write("materials/soft.toml", "[sample]\ncount = 65\n");
   EXPECT_NE(parseProtocol(file, text, sc).effectiveText(), effective);
 
@@ -355,16 +369,7 @@ TEST_F(Included, TheProtocolAsRunDoesNotDependOnHowItsPathWasSpelled) {
 }
 
 TEST_F(Included, AKeyIsGivenOnceAndABadIncludeIsNamedAtItsLine) {
-  const Schema sc = schema();
-  auto problems = [&](const std::string& text) {
-    const std::string file = write("p.toml", text);
-    try {
-      parseProtocol(file, text, sc);
-    } catch (const ProtocolError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto problems = [&](const std::string& text) { return Included::problems("p.toml", text); };
   const std::string p = (dir_ / "p.toml").string();
   write("materials/soft.toml", kMaterial);
   // Given in both: named at the material's line with the protocol's place.
@@ -438,24 +443,12 @@ TEST_F(Included, AVariantGivesOnlyWhatDiffersFromItsBase) {
   const std::string effective = s.effectiveText();
   EXPECT_EQ(effective.find("base ="), std::string::npos) << effective;
   EXPECT_NE(effective.find(" with base " + full), std::string::npos) << effective;
-  const Settings back = parseProtocol(file, effective, sc);
-  ASSERT_EQ(back.table().size(), s.table().size());
-  for (std::size_t k = 0; k < s.table().size(); ++k) {
-    EXPECT_EQ(back.table()[k].value, s.table()[k].value) << s.table()[k].key;
-  }
+  expectReadsBack(file, s);
   write("full.toml", "include = \"materials/soft.toml\"\n" + std::string(kGood) +
                          "[sample]\nfile = \"data/q.txt\"\n");
   EXPECT_NE(parseProtocol(file, text, sc).effectiveText(), effective);
 
-  auto problems = [&](const std::string& t) {
-    const std::string f = write("quick/q.toml", t);
-    try {
-      parseProtocol(f, t, sc);
-    } catch (const ProtocolError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto problems = [&](const std::string& t) { return Included::problems("quick/q.toml", t); };
   // Within the variant a key is still given once; its base's problems at their own lines.
   EXPECT_NE(
       problems("include = \"../materials/soft.toml\"\n" + text).find("sample.count is given again"),
