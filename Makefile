@@ -115,11 +115,13 @@ paper: build
 # each protocol at eight seeds, their values, mean and scatter (tests/README.md says how a check
 # holds a run to them). One protocol per process on a thread, two at a time, each into its own
 # notebook (about an hour and a quarter on 2 cores).
-# An explicit step: review `git diff tests/reference` before committing.
+# An explicit step: review `git diff tests/reference` before committing. REFERENCES picks some
+# (make references REFERENCES=protocols/biaxial-ucs-quick.toml).
+REFERENCES ?= $(wildcard protocols/*-quick.toml)
 references: build
 	@mkdir -p build/references
 	@rm -f build/references/*.sqlite*
-	ls protocols/*-quick.toml | xargs -P 2 -I{} sh -c '$(ROCKLAB) regress update {} \
+	ls $(REFERENCES) | xargs -P 2 -I{} sh -c '$(ROCKLAB) regress update {} \
 	  --out tests/reference --lab build/references/$$(basename {} .toml).sqlite --seeds 8 \
 	  --threads 1'
 
