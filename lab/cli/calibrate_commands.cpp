@@ -278,10 +278,11 @@ std::string Driver::material(const std::vector<Evaluation>& all, int best) const
   std::ostringstream t;
   t << "# Material calibrated by `rocklab calibrate " << c_.file << "` (calibration " << c_.name
     << ",\n# evaluation " << best << ", rocklab " << kVersion << ", " << notebook::utcNow()
-    << "). A protocol beside its target's includes it with\n#   include = \""
+    << "). A protocol beside its target runs the target on it with\n#   include = \""
     << fs::relative(fs::absolute(c_.material),
                     fs::absolute(c_.experiments.front().protocol).parent_path())
            .string()
+    << "\"\n#   base = \"" << fs::path(c_.experiments.front().protocol).filename().string()
     << "\"\n"
     << "# Targets, mean +- 95% interval over the calibration's seeds";
   const Evaluation* check = nullptr;
