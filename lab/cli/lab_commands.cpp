@@ -111,16 +111,16 @@ void writeWhole(const std::string& path, const std::string& text) {
 int checkProtocol(const std::string& path, const std::vector<std::string>& sets, bool print) {
   try {
     const auto c = rigs::checkProtocol(path, overridesOf(sets));
-    std::size_t given = 0, total = 0;
-    for (const auto& row : c.settings.table()) {
-      ++total;
-      given += c.settings.given(row.key);
-    }
     for (const std::string& w : rigs::unusedKeys(c.settings)) std::cerr << "warning: " << w << "\n";
     if (print) {
       std::cout << c.settings.effectiveText();
       std::cerr << path << ": a valid " << c.rig->name << " protocol\n";
       return 0;
+    }
+    std::size_t given = 0, total = 0;
+    for (const auto& row : c.settings.table()) {
+      ++total;
+      given += c.settings.given(row.key);
     }
     std::cout << path << ": a valid " << c.rig->name << " protocol (" << given << " keys set, "
               << total - given << " defaults)\n";

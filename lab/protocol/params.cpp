@@ -249,6 +249,13 @@ TomlValue parseToml(const std::string& file, const std::string& text) {
 
 namespace {
 
+// A file a protocol names (an include, its base), resolved against the protocol's folder.
+std::string besideProtocol(const std::string& file, const std::string& name) {
+  const std::filesystem::path p(name);
+  const std::filesystem::path folder = std::filesystem::path(file).parent_path();
+  return (p.is_absolute() ? p : folder / p).lexically_normal().string();
+}
+
 constexpr const char* kBase = "base";
 // A chain of bases longer than this is taken for a cycle (a protocol based on itself).
 constexpr int kMaxBases = 16;
@@ -263,9 +270,7 @@ std::string baseFile(const std::string& file, const TomlValue& root) {
                          " expects the file of the protocol this one varies, e.g. base = "
                          "\"biaxial-ucs.toml\" (relative to the protocol's folder)"});
   }
-  const std::filesystem::path p(v.as_string().str);
-  const std::filesystem::path folder = std::filesystem::path(file).parent_path();
-  return (p.is_absolute() ? p : folder / p).lexically_normal().string();
+  return besideProtocol(file, v.as_string().str);
 }
 
 std::string rigOf(const std::string& file, const std::string& text, int depth) {
@@ -513,11 +518,7 @@ std::vector<std::pair<std::string, Place>> includedFiles(const std::string& file
                            "\"materials/sandstone.toml\" (relative to the protocol's folder)");
     return files;
   }
-  const std::filesystem::path folder = std::filesystem::path(file).parent_path();
-  for (const std::string& n : names) {
-    const std::filesystem::path p(n);
-    files.emplace_back((p.is_absolute() ? p : folder / p).lexically_normal().string(), place);
-  }
+  for (const std::string& n : names) files.emplace_back(besideProtocol(file, n), place);
   return files;
 }
 
@@ -540,8 +541,7 @@ std::optional<Settings> readBase(const std::string& file, const TomlValue& root,
   }
   std::error_code ec;
   const std::string id = std::filesystem::weakly_canonical(path, ec).string();
-  if (std::find(t_bases.begin(), t_bases.end(), id) != t_bases.end() ||
-      t_bases.size() >= static_cast<std::size_t>(kMaxBases)) {
+  if (std::find(t_bases.begin(), t_bases.end(), id) != t_bases.end()) {
     problems.at(place, std::string(kBase) + ": " + path +
                            " is already a base of this protocol (a cycle of bases)");
     return std::nullopt;
@@ -629,8 +629,8 @@ Settings parseProtocol(const std::string& file, const std::string& text, const S
     for (const auto& [key, line] : base->given_) {
       if (s.given_.count(key)) continue;
       Value v = base->values_.at(key);
-      const auto* text = std::get_if<std::string>(&v);
-      if (text && !text->empty() && !std::filesystem::path(*text).is_absolute() &&
+      const auto* given = std::get_if<std::string>(&v);
+      if (given && !given->empty() && !std::filesystem::path(*given).is_absolute() &&
           schema.find(key)->unit.name == units::path.name) {
         v = std::filesystem::absolute(base->path(key))
                 .lexically_normal()
