@@ -4,15 +4,25 @@
 // Non-viscous: it damps the approach to equilibrium of quasi-static loading without a
 // rate, and vanishes at rest.
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include <Eigen/Core>
 
 namespace rocklab {
 
+// -alpha |f| sign(v) without a branch: the sign of a velocity component is a coin toss in a
+// settling sample, and a mispredicted branch per component cost more than the rest of the
+// integration (perf, 2D biaxial test). The same bits as the product: -alpha |f| where v > 0,
+// +alpha |f| where v < 0, and -0.0 where v is zero or not a number (-alpha |f| times 0), for
+// any finite force.
 inline double localDamping(double f, double v, double alpha) {
-  const double sign = v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0);
-  return -alpha * std::abs(f) * sign;
+  const double magnitude = alpha * std::abs(f);
+  const std::uint64_t opposed = std::bit_cast<std::uint64_t>(std::copysign(magnitude, -v));
+  const std::uint64_t moving = 0 - static_cast<std::uint64_t>((v > 0.0) | (v < 0.0));
+  constexpr std::uint64_t kNegativeZero = std::uint64_t{1} << 63;
+  return std::bit_cast<double>((opposed & moving) | (kNegativeZero & ~moving));
 }
 
 template <int R>

@@ -86,8 +86,9 @@ struct SimulationConfig {
                         "time step over the critical estimate"});
     f(timestep.density_scaling,
       {"numerics.density_scaling", units::none, Range::closed(1, 16),
-       "quasi-static stages: the critical step over the lightest particles' own, reached by "
-       "heavier inertial masses where needed (1: off; never in wave windows)"});
+       "quasi-static stages after the formation (formation.density_scaling is its own): the "
+       "critical step over the lightest particles' own, reached by heavier inertial masses "
+       "where needed (1: off; never in wave windows)"});
     f(local_damping, {"numerics.local_damping", units::none, Range::rightOpen(0, 1),
                       "PFC local damping coefficient"});
     f(threads, {"numerics.threads", units::none, Range::closed(1, 1024),

@@ -129,6 +129,14 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
       sp.frame->set(a, Axis{Mode::Stress, 0.0, target, 0.0});
     }
     steps += settle(sp, "formation", rec, control);
+    // The sample was formed at formation.density_scaling (buildSpecimen); the rest runs at
+    // numerics.density_scaling, the servo's cap still a move per step at the new step.
+    const double loading_scaling = sp.settings.simulation.timestep.density_scaling;
+    if (loading_scaling != f.density_scaling) {
+      sim.setDensityScaling(loading_scaling);
+      sp.frame->setServo(sp.settings.servo.alpha,
+                         sp.settings.servo.speed_radii_per_step * sp.mean_radius / sim.dt());
+    }
   } else {
     // The sample as it came (a file's): the walls stay at its box, the contacts as they are.
     ownFriction();

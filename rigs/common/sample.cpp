@@ -156,8 +156,11 @@ Specimen<D> buildSpecimen(const SpecimenSettings& s, RunControl& control) {
   sp.mean_radius =
       std::accumulate(p.radii.begin(), p.radii.end(), 0.0) / static_cast<double>(p.radii.size());
   // The Verlet skin is the configuration's ratio of the mean radius (the core takes it).
-  sp.sim =
-      std::make_unique<Simulation<D>>(materials(s.material, s.formation.friction), s.simulation);
+  // Formed at the formation's density scaling (formation.density_scaling); formAndCement
+  // hands the loading numerics.density_scaling.
+  SimulationConfig config = s.simulation;
+  if (s.formation.enabled) config.timestep.density_scaling = s.formation.density_scaling;
+  sp.sim = std::make_unique<Simulation<D>>(materials(s.material, s.formation.friction), config);
   auto& sim = *sp.sim;
   sim.particles().thickness = s.sample.packing.thickness;
   sim.rng().reseed(static_cast<std::uint64_t>(s.protocol.seed) ^ 0x5eedb0d5ull);  // bonds' stream

@@ -157,6 +157,7 @@ struct FormationSettings {
   double unbalanced_force_ratio = 0.01;
   std::int64_t max_steps = 2000000;
   double local_damping = 0.7;
+  double density_scaling = 1.0;
   double densified_porosity_change = 0.0;
   std::int64_t densified_window_steps = 20000;
 
@@ -184,6 +185,10 @@ struct FormationSettings {
     f(local_damping, {"local_damping", units::none, Range::rightOpen(0, 1),
                       "local damping while the sample is densified (numerics.local_damping "
                       "is the rest's); less lets the frictionless grains rearrange sooner"});
+    f(density_scaling,
+      {"density_scaling", units::none, Range::closed(1, 16),
+       "density scaling while the sample is formed (numerics.density_scaling is the loading's): "
+       "the formed sample depends on the path to it, so 1 forms it at its physical masses"});
     f(densified_porosity_change,
       {"densified_porosity_change", units::none, Range::closed(0, 0.1),
        "densification also ends, with the walls at their stress, when the porosity fell by "

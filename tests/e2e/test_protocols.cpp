@@ -333,6 +333,35 @@ TEST(Protocols, DensificationHasItsOwnDampingAndEndsWhenItsPorosityStopsFalling)
   std::filesystem::remove(file);
 }
 
+// The formation's own density scaling (formation.density_scaling): at 1 the sample forms as
+// it does unscaled whatever numerics.density_scaling gives the loading, bit for bit, and
+// that loading then takes fewer steps; at 4 the formation itself is another path.
+TEST(Protocols, TheFormationHasItsOwnDensityScaling) {
+  const std::string file =
+      writeProtocol("scaled", std::string("[protocol]\nname = \"scaled\"\nrig = \"oedometer\"\n") +
+                                  kSmallSample + "[loading]\naxial_strain_max = 0.004\n");
+  auto run = [&](const Lab& lab, const std::string& keys) {
+    std::string out;
+    EXPECT_EQ(rocklab::testing::runRocklab(
+                  "run " + file + " --quiet --threads 1 --lab " + lab.path + keys, &out),
+              0)
+        << out;
+    return nb::Notebook(lab.path);
+  };
+  Lab a("scaled-a"), b("scaled-b"), c("scaled-c");
+  nb::Notebook na = run(a, ""), nb = run(b, " --set numerics.density_scaling=4"),
+               nc = run(c, " --set formation.density_scaling=4");
+  const std::string formed =
+      "SELECT group_concat(name || '=' || value, ' ') FROM results WHERE name IN "
+      "('formation_steps', 'porosity_after_formation', 'coordination_after_formation')";
+  EXPECT_EQ(scalar(na, formed), scalar(nb, formed));
+  EXPECT_NE(scalar(na, formed), scalar(nc, formed));
+  EXPECT_LT(result(nb, "loading_steps"), 0.75 * result(na, "loading_steps"));
+  // the loading unscaled: as many steps as unscaled, to the sample's change of its step
+  EXPECT_NEAR(result(nc, "loading_steps") / result(na, "loading_steps"), 1.0, 0.1);
+  std::filesystem::remove(file);
+}
+
 // The same rig with disks (2D), driven by a stress ramp.
 TEST(Protocols, DisksUnderAStressRamp) {
   Lab lab("disks");

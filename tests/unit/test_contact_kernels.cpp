@@ -1,18 +1,41 @@
 // The contact kernels against hand calculations: normal laws, mixing, Coulomb sliding,
-// dissipation, frame invariance; and the law registry.
+// dissipation, frame invariance; the law registry; and PFC's local damping.
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <bit>
 #include <cmath>
+#include <limits>
 
 #include "lab/core/contact_law_hertz.hpp"
 #include "lab/core/contact_law_linear.hpp"
 #include "lab/core/contact_laws.hpp"
 #include "lab/core/errors.hpp"
+#include "lab/core/local_damping.hpp"
 
 namespace rocklab {
 namespace {
+
+// The branch-free local damping gives the bits of its defining product, -alpha |f| sign(v),
+// for every sign and zero of force and velocity (a changed bit would change every settled
+// sample's path).
+TEST(LocalDamping, TheBranchFreeFormGivesTheBitsOfTheProduct) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double fs[] = {0.0, -0.0, 1.5, -1.5, 3e-310, -7.25e12, 1e300};
+  const double vs[] = {0.0, -0.0, 2.0, -2.0, 4e-320, -1e-12, nan, -nan};
+  for (const double alpha : {0.0, 0.3, 0.7}) {
+    for (const double f : fs) {
+      for (const double v : vs) {
+        const double sign = v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0);
+        const double product = -alpha * std::abs(f) * sign;
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(localDamping(f, v, alpha)),
+                  std::bit_cast<std::uint64_t>(product))
+            << "alpha " << alpha << ", f " << f << ", v " << v;
+      }
+    }
+  }
+}
 
 ContactKinematics<3> restingContact(double overlap, double r, double mstar) {
   ContactKinematics<3> k;
