@@ -704,6 +704,12 @@ std::vector<std::string> quickHydrostatic(const std::string& lab) {
   return checkpointedRun("hydrostatic-quick", lab, {"sample.count=600"});
 }
 
+// The same with its loading density-scaled: the masses and the step change after the formation.
+std::vector<std::string> scaledHydrostatic(const std::string& lab) {
+  return checkpointedRun("hydrostatic-quick", lab,
+                         {"sample.count=600", "numerics.density_scaling=4"});
+}
+
 // A biaxial test in the permeameter: the fluid's networks and pressures (applied to the
 // particles) carried through the checkpoints of the loading loop.
 std::vector<std::string> quickPermeameter(const std::string& lab) {
@@ -783,6 +789,27 @@ TEST(Protocols, AKilledRunResumesToTheUninterruptedRunOnceOrTwice) {
   for (const Lab* l : {&reference, &killed, &twice}) {
     std::filesystem::remove_all(l->path + ".files");
   }
+}
+
+// A run killed in a density-scaled loading (the sample formed at its physical masses, the
+// loading's heavier ones and longer step set after it) resumes to the uninterrupted run.
+TEST(Protocols, AKilledDensityScaledLoadingResumesToTheUninterruptedRun) {
+  Lab reference("resume-scaled-reference"), killed("resume-scaled-killed");
+  std::string out;
+  resume::start(resume::scaledHydrostatic(reference.path));
+  int status = 0;
+  wait(&status);
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  const double delay = resume::randomDelay(0.0, 1.5);
+  SCOPED_TRACE("killed " + std::to_string(delay) + " s into the loading");
+  ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::scaledHydrostatic(killed.path)),
+                                        killed.path, delay));
+  ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --threads 2 --lab " + killed.path, &out),
+            0)
+      << out;
+  resume::expectSameRun(reference.path, killed.path);
+  std::filesystem::remove_all(reference.path + ".files");
+  std::filesystem::remove_all(killed.path + ".files");
 }
 
 // The permeameter killed in its axial loading: the loading loop resumes from its own
