@@ -19,15 +19,18 @@ namespace rocklab::reports {
 namespace {
 
 // The keys whose values differ between the runs: what the study varied, and the seed of a
-// study over seeds; the run's own bookkeeping (threads) does not change results.
+// study over seeds; the run's own bookkeeping (threads) does not change results. Every run's
+// keys count: a run of an older rocklab may lack a key the others vary.
 std::vector<std::string> variedKeys(const std::vector<RunData>& runs) {
   std::vector<std::string> keys;
-  for (const auto& [key, value, unit] : runs.front().params) {
-    if (key == "numerics.threads") continue;
-    for (const RunData& r : runs) {
-      if (r.param(key) != value) {
-        keys.push_back(key);
-        break;
+  for (const RunData& first : runs) {
+    for (const auto& [key, value, unit] : first.params) {
+      if (key == "numerics.threads" || std::ranges::find(keys, key) != keys.end()) continue;
+      for (const RunData& r : runs) {
+        if (r.param(key) != value) {
+          keys.push_back(key);
+          break;
+        }
       }
     }
   }

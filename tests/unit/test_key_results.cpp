@@ -237,6 +237,36 @@ TEST(AccuracyStudy, ErrorParetoFrontAndCheapestWithinTolerance) {
   for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(lab + ext);
 }
 
+// A key the first run lacks (a run of an older rocklab) but the others vary is varied too:
+// each of its values is a setting of its own.
+TEST(AccuracyStudy, AKeyTheFirstRunLacksIsStillVaried) {
+  const std::string lab = (std::filesystem::temp_directory_path() /
+                           ("rocklab-study-keys-" + std::to_string(::getpid()) + ".sqlite"))
+                              .string();
+  std::filesystem::remove(lab);
+  std::vector<std::int64_t> ids;
+  {
+    notebook::Notebook nb(lab);
+    const std::vector<std::vector<notebook::ParamRow>> params = {
+        {}, {{"formation.density_scaling", "1", "-"}}, {{"formation.density_scaling", "4", "-"}}};
+    for (std::size_t k = 0; k < params.size(); ++k) {
+      notebook::RunInfo info;
+      info.protocol = "biaxial-ucs";
+      info.rig = "biaxial";
+      std::vector<notebook::ParamRow> p = params[k];
+      p.push_back({"protocol.key_results", "[\"ucs_MPa\"]", ""});
+      notebook::RunWriter w(nb, info, p);
+      w.result("ucs_MPa", 5.0 + static_cast<double>(k), "MPa");
+      w.finish(notebook::RunStatus::Completed);
+      ids.push_back(w.id());
+    }
+  }
+  const Study s = evaluateStudy(lab, ids, 0.05);
+  EXPECT_EQ(s.varied, std::vector<std::string>{"formation.density_scaling"});
+  EXPECT_EQ(s.points.size(), 3u);
+  for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(lab + ext);
+}
+
 // A study over seeds: runs that differ only in their seed are one setting, compared by their
 // means. A deviation the seeds cannot resolve is no loss of accuracy, one beyond the scatter
 // is, and so is one the seeds resolve in pairs (the same seed is the same sample): with a 1%
