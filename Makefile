@@ -143,8 +143,8 @@ GALLERY_DIR := build/gallery
 STUDY = $(ROCKLAB) study accuracy --threads 1 --quiet --lab $(GALLERY_DIR)/lab-$@.sqlite \
   --out $(GALLERY_DIR)/$@
 GALLERY := oedometer biaxial envelope hydrostatic permeameter ultrasonic fewer-steps \
-  oedometer-rate-boost formation-end compaction-band-rate-boost shear-band-rate-boost \
-  envelope-rate-boost
+  fewer-steps-slow oedometer-rate-boost formation-end compaction-band-rate-boost \
+  shear-band-rate-boost envelope-rate-boost
 .PHONY: $(GALLERY)
 gallery: $(GALLERY)
 	@echo "gallery: reports/gallery/{$(shell echo $(GALLERY) | tr ' ' ,)}.png"
@@ -179,6 +179,17 @@ ultrasonic: build
 fewer-steps: build
 	$(STUDY) protocols/biaxial-ucs-quick.toml --vary numerics.density_scaling=1,2,4 \
 	  --vary loading.rate_boost_max=1,2 --seeds 5
+	$(gallery_png)
+# The same at the rate the 2D superparticle protocols load at (0.3125 /s, biaxial-ucs.toml) and
+# the quick count, the loading scaled alone on each seed's formed sample and with its formation
+# (protocols/campaigns/fewer-steps-superparticle-2d.toml, run on the local pool).
+FEWER_STEPS_SLOW = protocols/campaigns/fewer-steps-superparticle-2d.toml
+fewer-steps-slow: build
+	$(ROCKLAB) campaign run $(FEWER_STEPS_SLOW) --quiet --lab $(GALLERY_DIR)/lab-$@.sqlite
+	$(ROCKLAB) study report --lab $(GALLERY_DIR)/lab-$@.sqlite --out $(GALLERY_DIR)/$@ \
+	  $$($(ROCKLAB) notebook --csv --lab $(GALLERY_DIR)/lab-$@.sqlite sql "SELECT run_id FROM \
+	  campaign_points p JOIN campaigns c ON c.id = p.campaign_id WHERE \
+	  c.name = 'fewer-steps-superparticle-2d' ORDER BY point, seed" | tail -n +2)
 	$(gallery_png)
 # The adaptive rate in the oedometer (off in the protocol: with its cycles at the set rate
 # it saves only 7%).
