@@ -723,6 +723,33 @@ double randomDelay(double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
 
+// Runs `run(lab)` through, and again killed `lo` to `hi` s into its loading (its first
+// series named like `loading_series`); resumes the killed one on two threads and compares it
+// with the first. Returns what the resume printed.
+template <class Run>
+std::string killedAndResumed(const std::string& name, Run run, double lo, double hi,
+                             const std::string& loading_series = "loading.%") {
+  Lab reference(name + "-reference"), killed(name + "-killed");
+  std::string out;
+  start(run(reference.path));
+  int status = 0;
+  wait(&status);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const double delay = randomDelay(lo, hi);
+  SCOPED_TRACE("killed " + std::to_string(delay) + " s into the loading");
+  if (killDuringLoading(start(run(killed.path)), killed.path, delay, loading_series)) {
+    EXPECT_EQ(
+        rocklab::testing::runRocklab("resume 1 --quiet --threads 2 --lab " + killed.path, &out), 0)
+        << out;
+    expectSameRun(reference.path, killed.path);
+  } else {
+    ADD_FAILURE() << "the run ended before it was killed";
+  }
+  std::filesystem::remove_all(reference.path + ".files");
+  std::filesystem::remove_all(killed.path + ".files");
+  return out;
+}
+
 }  // namespace resume
 
 // SIGTERM during a run: the run is closed as interrupted, with what it recorded until then.
@@ -794,45 +821,16 @@ TEST(Protocols, AKilledRunResumesToTheUninterruptedRunOnceOrTwice) {
 // A run killed in a density-scaled loading (the sample formed at its physical masses, the
 // loading's heavier ones and longer step set after it) resumes to the uninterrupted run.
 TEST(Protocols, AKilledDensityScaledLoadingResumesToTheUninterruptedRun) {
-  Lab reference("resume-scaled-reference"), killed("resume-scaled-killed");
-  std::string out;
-  resume::start(resume::scaledHydrostatic(reference.path));
-  int status = 0;
-  wait(&status);
-  ASSERT_EQ(WEXITSTATUS(status), 0);
-  const double delay = resume::randomDelay(0.0, 1.5);
-  SCOPED_TRACE("killed " + std::to_string(delay) + " s into the loading");
-  ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::scaledHydrostatic(killed.path)),
-                                        killed.path, delay));
-  ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --threads 2 --lab " + killed.path, &out),
-            0)
-      << out;
-  resume::expectSameRun(reference.path, killed.path);
-  std::filesystem::remove_all(reference.path + ".files");
-  std::filesystem::remove_all(killed.path + ".files");
+  resume::killedAndResumed("resume-scaled", resume::scaledHydrostatic, 0.0, 1.5);
 }
 
 // The permeameter killed in its axial loading: the loading loop resumes from its own
 // checkpoint, with the pore networks and the pressures on the particles as they were.
 TEST(Protocols, APermeameterKilledInItsLoadingResumesToTheUninterruptedRun) {
-  Lab reference("resume-flow-reference"), killed("resume-flow-killed");
-  std::string out;
-  resume::start(resume::quickPermeameter(reference.path));
-  int status = 0;
-  wait(&status);
-  ASSERT_EQ(WEXITSTATUS(status), 0);
   // The loading takes about 8 s of the run's 10 (one thread): past 0.5 s it has checkpointed.
-  const double delay = resume::randomDelay(0.5, 3.0);
-  SCOPED_TRACE("killed " + std::to_string(delay) + " s into the loading");
-  ASSERT_TRUE(resume::killDuringLoading(resume::start(resume::quickPermeameter(killed.path)),
-                                        killed.path, delay, "deviatoric_stress_MPa"));
-  ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --threads 2 --lab " + killed.path, &out),
-            0)
-      << out;
+  const std::string out = resume::killedAndResumed("resume-flow", resume::quickPermeameter, 0.5,
+                                                   3.0, "deviatoric_stress_MPa");
   EXPECT_NE(out.find("(loading), mid"), std::string::npos) << out;
-  resume::expectSameRun(reference.path, killed.path);
-  std::filesystem::remove_all(reference.path + ".files");
-  std::filesystem::remove_all(killed.path + ".files");
 }
 
 // A run whose protocol (a value, not its wording) or code changed since its checkpoint is
