@@ -296,6 +296,16 @@ TEST(Protocols, OedometerRateBoostsWhileCalmAndNeedsStrainControl) {
   std::filesystem::remove(refused);
 }
 
+// `rocklab run FILE` on one thread into the lab, with KEYS (" --set k=v ..."); its notebook.
+nb::Notebook runWith(const std::string& file, const Lab& lab, const std::string& keys) {
+  std::string out;
+  EXPECT_EQ(rocklab::testing::runRocklab(
+                "run " + file + " --quiet --threads 1 --lab " + lab.path + keys, &out),
+            0)
+      << out;
+  return nb::Notebook(lab.path);
+}
+
 // The densification's own damping (formation.local_damping) and its end by porosity
 // (formation.densified_porosity_change): the densification runs at its damping, what comes
 // after at numerics.local_damping again, and a porosity that stops falling ends it.
@@ -307,14 +317,7 @@ TEST(Protocols, DensificationHasItsOwnDampingAndEndsWhenItsPorosityStopsFalling)
       " --set formation.local_damping=0.3 --set formation.densified_porosity_change=0.05"
       " --set formation.densified_window_steps=200";
   const std::string file = writeProtocol("densify", head);
-  auto run = [&](const Lab& lab, const std::string& keys) {
-    std::string out;
-    EXPECT_EQ(rocklab::testing::runRocklab(
-                  "run " + file + " --quiet --threads 1 --lab " + lab.path + keys, &out),
-              0)
-        << out;
-    return nb::Notebook(lab.path);
-  };
+  auto run = [&](const Lab& lab, const std::string& keys) { return runWith(file, lab, keys); };
   Lab a("densify-a"), b("densify-b"), c("densify-c");
   nb::Notebook na = run(a, stall), nb = run(b, stall + " --set numerics.local_damping=0.3"),
                nc = run(c, "");
@@ -340,14 +343,7 @@ TEST(Protocols, TheFormationHasItsOwnDensityScaling) {
   const std::string file =
       writeProtocol("scaled", std::string("[protocol]\nname = \"scaled\"\nrig = \"oedometer\"\n") +
                                   kSmallSample + "[loading]\naxial_strain_max = 0.004\n");
-  auto run = [&](const Lab& lab, const std::string& keys) {
-    std::string out;
-    EXPECT_EQ(rocklab::testing::runRocklab(
-                  "run " + file + " --quiet --threads 1 --lab " + lab.path + keys, &out),
-              0)
-        << out;
-    return nb::Notebook(lab.path);
-  };
+  auto run = [&](const Lab& lab, const std::string& keys) { return runWith(file, lab, keys); };
   Lab a("scaled-a"), b("scaled-b"), c("scaled-c");
   nb::Notebook na = run(a, ""), nb = run(b, " --set numerics.density_scaling=4"),
                nc = run(c, " --set formation.density_scaling=4");
