@@ -23,8 +23,8 @@ namespace {
 // keys count: a run of an older rocklab may lack a key the others vary.
 std::vector<std::string> variedKeys(const std::vector<RunData>& runs) {
   std::vector<std::string> keys;
-  for (const RunData& first : runs) {
-    for (const auto& [key, value, unit] : first.params) {
+  for (const RunData& run : runs) {
+    for (const auto& [key, value, unit] : run.params) {
       if (key == "numerics.threads" || std::ranges::find(keys, key) != keys.end()) continue;
       for (const RunData& r : runs) {
         if (r.param(key) != value) {

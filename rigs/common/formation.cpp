@@ -135,8 +135,7 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
     if (loading_scaling != f.density_scaling) {
       sim.setDensityScaling(loading_scaling);
       if (!(sim.dt() > 0.0)) sim.prepare();  // read back from a checkpoint: its step comes here
-      sp.frame->setServo(sp.settings.servo.alpha,
-                         sp.settings.servo.speed_radii_per_step * sp.mean_radius / sim.dt());
+      sp.setServo();
     }
   } else {
     // The sample as it came (a file's): the walls stay at its box, the contacts as they are.

@@ -186,7 +186,7 @@ Specimen<D> buildSpecimen(const SpecimenSettings& s, RunControl& control) {
   }
   sp.frame = std::make_unique<LoadingFrame<D>>(sim, p.lo, p.hi, 1);
   sim.prepare();
-  sp.frame->setServo(s.servo.alpha, s.servo.speed_radii_per_step * sp.mean_radius / sim.dt());
+  sp.setServo();
   unit.finish(sp);
   return sp;
 }

@@ -48,6 +48,12 @@ std::size_t Specimen<D>::crushedGrains() const {
 }
 
 template <int D>
+void Specimen<D>::setServo() {
+  frame->setServo(settings.servo.alpha,
+                  settings.servo.speed_radii_per_step * mean_radius / sim->dt());
+}
+
+template <int D>
 void Specimen<D>::resetBrokenCount() {
   for (int m = 0; m < 2; ++m) {
     const auto mode = m == 0 ? BondBreakMode::Tensile : BondBreakMode::Shear;

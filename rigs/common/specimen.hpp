@@ -57,6 +57,9 @@ struct Specimen {
   std::uint64_t brokenInGrains(BondBreakMode mode) const;  // intragranular
   std::size_t crushedGrains() const;  // grains in more fragments than at the reference
   void resetBrokenCount();
+  // The frame's servo gain and speed cap: numerics.servo_speed_radii_per_step mean radii per
+  // step at the simulation's present step (set again when the step changes its meaning).
+  void setServo();
   // The specimen's state for a run's checkpoints (rigs/common/journal.hpp): the
   // simulation, the frame and what the rig keeps; reading back rebuilds them.
   template <class Archive>
