@@ -23,6 +23,7 @@
 #include "lab/cli/lab_commands.hpp"
 #include "lab/notebook/merge.hpp"
 #include "reports/campaign_report.hpp"
+#include "rigs/common/formed_samples.hpp"
 #include "rigs/registry.hpp"
 
 namespace rocklab::cli {
@@ -488,6 +489,11 @@ int campaignTask(const CampaignOptions& o) {
     work = scratch + "/" + fs::path(shard).filename().string();
     moveNotebook(shard, work);
   }
+  // The formed samples (formation.reuse) of the lab the campaign runs for, which all its
+  // tasks share: the shard folder is campaignDir(lab, name).
+  std::string lab = fs::path(fs::absolute(o.shard_dir)).lexically_normal().parent_path().string();
+  if (lab.ends_with(".campaigns")) lab.resize(lab.size() - std::string_view(".campaigns").size());
+  const std::string formed = rigs::formedSamplesDir(lab);
   int code = 0;
   bool fresh = !fs::exists(work);
   if (!fresh) {
@@ -495,6 +501,7 @@ int campaignTask(const CampaignOptions& o) {
     r.lab = work;
     r.quiet = o.quiet;
     r.threads = c.threads;
+    r.formed_dir = formed;
     code = resumeRun(1, r);
     fresh = code == 2;  // it cannot resume (its protocol or rocklab changed): run it anew
     if (fresh) removeNotebook(work);
@@ -504,7 +511,7 @@ int campaignTask(const CampaignOptions& o) {
       const rigs::CheckedProtocol p = rigs::checkProtocol(c.protocol, c.overrides(t));
       protocol::Settings settings = p.settings;
       settings.runChoice("numerics.threads", static_cast<std::int64_t>(c.threads));
-      code = runSettings(*p.rig, settings, c.protocol, work, o.quiet).code;
+      code = runSettings(*p.rig, settings, c.protocol, work, o.quiet, 0, formed).code;
     } catch (const protocol::ProtocolError& e) {
       std::cerr << e.what() << "\n";
       code = 2;

@@ -16,6 +16,7 @@
 #include "reports/key_results.hpp"
 #include "reports/run_data.hpp"
 #include "rigs/common/checked_recorder.hpp"
+#include "rigs/common/formed_samples.hpp"
 #include "rigs/registry.hpp"
 
 namespace rocklab::cli {
@@ -205,7 +206,7 @@ rigs::Journal::Options journalOptions(const protocol::Settings& settings) {
 
 RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& settings,
                        const std::string& protocol_file, const std::string& lab, bool quiet,
-                       std::int64_t resume_run) {
+                       std::int64_t resume_run, const std::string& formed_dir) {
   notebook::Notebook nb(lab);
   std::unique_ptr<notebook::RunWriter> writer;
   std::optional<rigs::Journal> journal;
@@ -244,6 +245,11 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
   std::signal(SIGTERM, onSignal);
   rigs::RunControl control(!quiet && isatty(STDERR_FILENO), interruption);
   control.setJournal(&*journal);
+  if (settings.flag("formation.reuse")) {
+    control.setFormedSamples(
+        {formed_dir.empty() ? rigs::formedSamplesDir(lab) : formed_dir,
+         notebook::hashText(rigs::formationIdentity(settings) + "code = " + kGitRevision)});
+  }
   NotebookRecorder notebook_rec(*writer);
   SkippedWhileReplaying replay_rec(notebook_rec, control);
   rigs::CheckedRecorder rec(replay_rec, rig.outputs(), std::string(rig.name));
@@ -393,7 +399,7 @@ int resumeRun(std::int64_t run, const RunOptions& o) {
   }
   const auto c = recheck(run, r, {}, o.threads);
   if (!c) return 2;
-  return runSettings(*c->rig, c->settings, r.file, o.lab, o.quiet, run).code;
+  return runSettings(*c->rig, c->settings, r.file, o.lab, o.quiet, run, o.formed_dir).code;
 }
 
 int notebookCommand(const NotebookOptions& o) {

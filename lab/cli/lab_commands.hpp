@@ -15,6 +15,7 @@ struct RunOptions {
   bool quiet = false;
   int threads = 0;                // 0: as the protocol says
   std::vector<std::string> sets;  // "KEY=VALUE" from --set, in order
+  std::string formed_dir;         // formed samples (formation.reuse); empty: beside the lab
 };
 
 // Returns the process exit code: 0 completed, 1 failed, 2 invalid protocol, 130 interrupted.
@@ -39,9 +40,11 @@ struct RunOutcome {
 };
 // Runs checked settings into the notebook `lab` as one run, or (resume_run > 0) continues
 // that run of the notebook from its last checkpoint.
+// Formed samples (formation.reuse) are kept in `formed_dir`, by default beside `lab`
+// (rigs::formedSamplesDir).
 RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& settings,
                        const std::string& protocol_file, const std::string& lab, bool quiet,
-                       std::int64_t resume_run = 0);
+                       std::int64_t resume_run = 0, const std::string& formed_dir = {});
 int listKeys(const std::string& rig);
 
 struct NotebookOptions {

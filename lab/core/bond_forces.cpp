@@ -1,6 +1,7 @@
 #include "lab/core/bond_forces.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <type_traits>
 
@@ -94,6 +95,15 @@ void BondForces<D>::compute(BondPass<D>& pass) {
     if (!adjacency_valid_) buildAdjacency(P.size(), B);
   }
 
+  if (tracking_ && !peaks_lost_ && peaks_.tensile.size() != nb) {
+    if (peaks_.tensile.empty()) {
+      peaks_.tensile.assign(nb, -std::numeric_limits<double>::infinity());
+      peaks_.cohesion.assign(nb, -std::numeric_limits<double>::infinity());
+    } else {
+      peaks_lost_ = true;  // a bond was added or removed: the peaks name other bonds now
+    }
+  }
+  const bool tracking = tracking_ && !peaks_lost_;
   tan_friction_.clear();
   moment_factor_.clear();
   joint_friction_.clear();
@@ -154,10 +164,15 @@ void BondForces<D>::compute(BondPass<D>& pass) {
                     const Ang<D>& tj, double tensile_stress, double shear_stress)
       __attribute__((always_inline)) {
     double shear_strength = B.shear[b];
-    if (pass.breakable && (moments_scaled || frictional)) {  // only breaks need them
+    if ((pass.breakable || tracking) && (moments_scaled || frictional)) {  // breaks need them
       const auto section = BondSection<D>::of(B.radius[b], P.thickness);
       if (moments_scaled) scaledStresses(b, section, tensile_stress, shear_stress);
       if (frictional) shear_strength = frictionalStrength(b, section);
+    }
+    if (tracking) {  // each bond is settled by one thread: no race
+      peaks_.tensile[b] = std::max(peaks_.tensile[b], tensile_stress);
+      peaks_.cohesion[b] =
+          std::max(peaks_.cohesion[b], shear_stress - (shear_strength - B.shear[b]));
     }
     if (pass.breakable && (tensile_stress >= B.tensile[b] || shear_stress >= shear_strength)) {
       const double rt = tensile_stress / B.tensile[b], rs = shear_stress / shear_strength;

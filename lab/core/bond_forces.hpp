@@ -53,6 +53,21 @@ class BondForces {
   void compute(BondPass<D>& pass);
   // Call when bonds are added or removed or particles reordered.
   void invalidate() { adjacency_valid_ = false; }
+  // From now on each parallel bond's highest peripheral stresses are kept: the tensile
+  // stress and the shear stress less its frictional part (the cohesion it needed). A bond
+  // holds for as long as its strengths exceed both, so another draw of strengths above them
+  // takes the same path (formed samples reused: rigs/common/formed_samples.hpp). Off with
+  // false; the peaks are lost when a bond is added or removed (peaks() is then null).
+  void trackPeaks(bool on) {
+    tracking_ = on, peaks_lost_ = false;
+    peaks_.tensile.clear(), peaks_.cohesion.clear();
+  }
+  struct Peaks {
+    std::vector<double> tensile, cohesion;  // Pa, per bond in store order
+  };
+  const Peaks* peaks(std::size_t bonds) const {
+    return tracking_ && peaks_.tensile.size() == bonds && !peaks_lost_ ? &peaks_ : nullptr;
+  }
 
  private:
   void buildAdjacency(std::size_t particles, const BondStore<D>& bonds);
@@ -79,6 +94,8 @@ class BondForces {
   std::vector<BlockOut> block_;
   std::vector<double> tan_friction_, moment_factor_, joint_friction_;  // per kind, this pass
   std::vector<FaceLayout> layouts_;                                    // per kind (flat joints)
+  bool tracking_ = false, peaks_lost_ = false;
+  Peaks peaks_;
 };
 
 }  // namespace rocklab

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -238,6 +239,18 @@ class Simulation {
   // particles held leaves with them. A pebble of an unbroken clump cannot be removed alone.
   void removeParticles(const std::vector<ParticleId>& ids);
   const BondStore<D>& bonds() const { return bonds_; }
+  // Draws the strengths of every bond of kind `kind_index` again, from the scene's random
+  // stream in bond order as cement() drew them, for `kind`, which replaces the kind and
+  // differs from it in its strengths only. Returns the draws <= 0 drawn again, or nullopt,
+  // changing nothing, when a draw is <= 0 and the kind skips such bonds (cement() would not
+  // have installed that bond). Parallel bonds only (a flat joint's slits draw as well).
+  std::optional<std::size_t> redrawStrengths(std::uint8_t kind_index, const BondKind& kind);
+  // Keeps each bond's peak stresses from now on (BondForces::trackPeaks); bondPeaks() is
+  // null when they are not kept or were lost to a bond added or removed.
+  void trackBondPeaks(bool on) { bond_forces_.trackPeaks(on); }
+  const typename BondForces<D>::Peaks* bondPeaks() const {
+    return bond_forces_.peaks(bonds_.size());
+  }
   // Bonds broken so far of a kind and mode.
   std::uint64_t brokenBonds(std::uint8_t kind, BondBreakMode mode) const;
   // Every bond break since the scene began, oldest first. Observers read on from where they

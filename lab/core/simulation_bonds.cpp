@@ -69,6 +69,43 @@ std::uint64_t Simulation<D>::brokenBonds(std::uint8_t kind, BondBreakMode mode) 
   return broken_counts_.at(2 * kind + (mode == BondBreakMode::Shear ? 1 : 0));
 }
 
+namespace {
+
+// A strength from normal(mean, sd), as cement() draws it: one at or below zero is drawn again
+// with Resample (counted in `redrawn`), else left for the caller to skip.
+double drawStrength(Rng& rng, double mean, double sd, NegativeStrength negative,
+                    std::size_t& redrawn) {
+  double s = rng.normal(mean, sd);
+  while (s <= 0.0 && negative == NegativeStrength::Resample) {
+    ++redrawn;
+    s = rng.normal(mean, sd);
+  }
+  return s;
+}
+
+}  // namespace
+
+template <int D>
+std::optional<std::size_t> Simulation<D>::redrawStrengths(std::uint8_t kind_index,
+                                                          const BondKind& kind) {
+  if (kind.model != BondModel::Parallel ||
+      bond_kinds_.at(kind_index).model != BondModel::Parallel) {
+    throw std::invalid_argument("redrawStrengths: parallel bonds only");
+  }
+  std::size_t redrawn = 0;
+  std::vector<double> tensile = bonds_.tensile, shear = bonds_.shear;
+  for (std::size_t b = 0; b < bonds_.size(); ++b) {
+    if (bonds_.kind[b] != kind_index) continue;
+    tensile[b] = drawStrength(rng_, kind.tensile_mean, kind.tensile_std, kind.negative, redrawn);
+    shear[b] = drawStrength(rng_, kind.shear_mean, kind.shear_std, kind.negative, redrawn);
+    if (tensile[b] <= 0.0 || shear[b] <= 0.0) return std::nullopt;
+  }
+  bonds_.tensile.swap(tensile);
+  bonds_.shear.swap(shear);
+  bond_kinds_[kind_index] = kind;
+  return redrawn;
+}
+
 template <int D>
 CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
   const BondKind& kind = bond_kinds_.at(kind_index);
@@ -89,11 +126,7 @@ CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
   std::sort(existing.begin(), existing.end());
   const FaceLayout layout = kind.template faceLayout<D>();
   auto draw = [&](double mean, double sd, bool& skip) {
-    double s = rng_.normal(mean, sd);
-    while (s <= 0.0 && kind.negative == NegativeStrength::Resample) {
-      ++report.redrawn;
-      s = rng_.normal(mean, sd);
-    }
+    const double s = drawStrength(rng_, mean, sd, kind.negative, report.redrawn);
     skip = skip || s <= 0.0;
     return s;
   };
@@ -209,6 +242,8 @@ void Simulation<D>::removeParticles(const std::vector<ParticleId>& ids) {
   template std::uint8_t Simulation<D>::addBondKind(BondKind);                           \
   template std::uint64_t Simulation<D>::brokenBonds(std::uint8_t, BondBreakMode) const; \
   template CementReport Simulation<D>::cement(std::uint8_t, double);                    \
+  template std::optional<std::size_t> Simulation<D>::redrawStrengths(std::uint8_t,      \
+                                                                     const BondKind&);  \
   template void Simulation<D>::removeParticles(const std::vector<ParticleId>&);
 ROCKLAB_BOND_STAGE(2)
 ROCKLAB_BOND_STAGE(3)

@@ -40,6 +40,13 @@ class Interrupted : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Where a lab keeps its formed samples (formed_samples.hpp), and the name of this run's.
+struct FormedSamples {
+  std::string dir;  // beside the lab: formedSamplesDir()
+  std::string key;  // the hash of formationIdentity() and the code version
+  std::string file() const { return dir + "/" + key + ".formed"; }
+};
+
 // Progress on stderr (when it is a terminal and not quiet) and the interruption check.
 class RunControl {
  public:
@@ -56,6 +63,10 @@ class RunControl {
   }
   // True while a resumed run replays what it had done: nothing is recorded.
   bool replaying() const { return journal_ && journal_->replaying(); }
+  // The lab's formed samples and this run's formation's name in them (formation.reuse;
+  // formed_samples.hpp); null: the run forms its sample and keeps nothing.
+  void setFormedSamples(FormedSamples f) { formed_ = std::move(f); }
+  const FormedSamples* formedSamples() const { return formed_.dir.empty() ? nullptr : &formed_; }
 
  private:
   bool show_;
@@ -66,6 +77,7 @@ class RunControl {
   std::uint64_t stage_steps0_ = 0;
   bool printed_ = false;
   Journal* journal_ = nullptr;
+  FormedSamples formed_;
 };
 
 }  // namespace rocklab::rigs

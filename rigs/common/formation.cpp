@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "rigs/common/formed_samples.hpp"
 #include "rigs/common/measurements.hpp"
 
 namespace rocklab::rigs {
@@ -113,7 +114,28 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
     sim.replaceMaterials(std::move(own));
   };
   std::uint64_t steps = 0;
-  if (f.enabled) {
+  if (sp.formed_from) {
+    // Formed by an earlier run of the lab (formed_samples.hpp): its records stand for the
+    // formation, which would have gone the very same way.
+    const FormedOrigin& o = *sp.formed_from;
+    o.records.replay(rec);
+    steps = o.densification_steps + o.formation_steps;
+    rec.message(sim.steps(), sim.time(), "info",
+                "formation.reuse: the sample formed by an earlier run with the same formation "
+                "(" +
+                    o.file + "), every grain bond stronger than it was loaded while forming; " +
+                    std::to_string(steps) + " steps not run again");
+  } else if (f.enabled) {
+    if (!sp.formed_note.empty()) {
+      rec.message(sim.steps(), sim.time(), "info", "formation.reuse: " + sp.formed_note);
+    }
+    // Kept for reuse only when formed here from its start (not resumed inside it), every
+    // record captured and each grain bond's peak stresses tracked throughout.
+    const FormedSamples* store = control.formedSamples();
+    const bool keep = store && !control.replaying();
+    if (keep) sim.trackBondPeaks(true);
+    FormationCapture capture(rec);
+    Recorder& forming = keep ? static_cast<Recorder&>(capture) : rec;
     // Densify isotropically at the lateral stress with the formation friction (a dense
     // packing), then with the grains' own friction take the formation state: a deviatoric
     // stress the low friction could not hold.
@@ -121,14 +143,27 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
     sim.setLocalDamping(f.local_damping);
     const Stall stall{static_cast<std::uint64_t>(f.densified_window_steps),
                       f.densified_porosity_change};
-    steps = settle(sp, "densification", rec, control, stall);
+    const std::uint64_t densification = settle(sp, "densification", forming, control, stall);
     sim.setLocalDamping(sp.settings.simulation.local_damping);
     ownFriction();
     for (int a = 0; a < D; ++a) {
       const double target = a == Specimen<D>::kAxial ? f.axial_stress : f.lateral_stress;
       sp.frame->set(a, Axis{Mode::Stress, 0.0, target, 0.0});
     }
-    steps += settle(sp, "formation", rec, control);
+    const std::uint64_t formation = settle(sp, "formation", forming, control);
+    steps = densification + formation;
+    if (keep) {
+      const std::string why =
+          capture.complete() ? keepFormed(*store, sp, densification, formation, capture.records())
+                             : "the formation recorded more than its series and messages";
+      if (!why.empty()) {
+        rec.message(sim.steps(), sim.time(), "info",
+                    "formation.reuse: the formed sample is not kept: " + why);
+      }
+      sim.trackBondPeaks(false);
+    }
+  }
+  if (f.enabled) {
     // The sample was formed at formation.density_scaling (buildSpecimen); the rest runs at
     // numerics.density_scaling, the servo's cap still a move per step at the new step.
     const double loading_scaling = sp.settings.simulation.timestep.density_scaling;

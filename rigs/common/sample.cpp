@@ -6,6 +6,7 @@
 
 #include "lab/core/grains.hpp"
 #include "lab/core/packing.hpp"
+#include "rigs/common/formed_samples.hpp"
 #include "rigs/common/specimen.hpp"
 
 namespace rocklab::rigs {
@@ -146,6 +147,13 @@ Specimen<D> buildSpecimen(const SpecimenSettings& s, RunControl& control) {
     restored.settings = s;
     if (unit.done(restored)) return restored;
   }
+  std::string formed_note;
+  if (const FormedSamples* store = control.formedSamples()) {
+    if (std::optional<Specimen<D>> formed = reuseFormed<D>(*store, s, formed_note)) {
+      unit.finish(*formed);
+      return std::move(*formed);
+    }
+  }
   control.tick("packing", 0, -1.0, "random placement and growth");
   std::vector<std::uint32_t> grain;
   std::vector<double> aspect_ratios;
@@ -185,6 +193,7 @@ Specimen<D> buildSpecimen(const SpecimenSettings& s, RunControl& control) {
     sp.grain_bonds = sim.cement(*sp.grain_kind, 1e-3);
   }
   sp.frame = std::make_unique<LoadingFrame<D>>(sim, p.lo, p.hi, 1);
+  sp.formed_note = std::move(formed_note);
   sim.prepare();
   sp.setServo();
   unit.finish(sp);

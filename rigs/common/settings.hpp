@@ -160,6 +160,7 @@ struct FormationSettings {
   double density_scaling = 1.0;
   double densified_porosity_change = 0.0;
   std::int64_t densified_window_steps = 20000;
+  bool reuse = false;
 
   template <class F>
   void fields(F& f) {
@@ -196,6 +197,12 @@ struct FormationSettings {
        "ratio ends it)"});
     f(densified_window_steps, {"densified_window_steps", units::none, Range::closed(100, 1e9),
                                "the window of formation.densified_porosity_change"});
+    f(reuse, {"reuse",
+              units::text,
+              {},
+              "keep the formed sample beside the lab and start from it in every later run whose "
+              "formation is the same (rigs/common/formed_samples.hpp): the same results, bit for "
+              "bit, without the formation's steps"});
   }
 };
 

@@ -117,6 +117,12 @@ void Specimen<D>::journal(Archive& ar) {
   }
   ar("bond_breaks_recorded", bond_breaks_recorded);
   ar("clump_breaks_recorded", clump_breaks_recorded);
+  bool formed = formed_from.has_value();
+  ar("formed_from.has", formed);
+  if constexpr (Archive::kReading)
+    formed_from = formed ? std::optional<FormedOrigin>(FormedOrigin{}) : std::nullopt;
+  if (formed) ar("formed_from", *formed_from);
+  ar("formed_note", formed_note);
 }
 
 template struct Specimen<2>;

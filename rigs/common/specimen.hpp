@@ -11,6 +11,7 @@
 
 #include "rigs/common/bond_classes.hpp"
 #include "rigs/common/experiment.hpp"
+#include "rigs/common/formation_records.hpp"
 #include "rigs/common/frame.hpp"
 #include "rigs/common/settings.hpp"
 
@@ -48,6 +49,11 @@ struct Specimen {
   // How much of the simulation's break logs has been handed to the notebook: the recorder
   // reads on from here and never empties the logs (they are the run's, not the observer's).
   std::size_t bond_breaks_recorded = 0, clump_breaks_recorded = 0;
+  // Formed by an earlier run of the lab (formation.reuse; formed_samples.hpp): formAndCement
+  // records the formation as that run did instead of forming the sample again. `formed_note`
+  // says why a sample was not taken from the lab or kept for it, for the notebook.
+  std::optional<FormedOrigin> formed_from;
+  std::string formed_note;
 
   static constexpr int kAxial = D - 1;  // z in 3D, y in 2D
   // A deep copy for a branch of the experiment (e.g. virgin and cored). The breaks before

@@ -33,6 +33,7 @@ struct Lab {
   ~Lab() { clean(); }
   void clean() {
     for (const char* ext : {"", "-wal", "-shm"}) std::filesystem::remove(path + ext);
+    for (const char* ext : {".files", ".formed"}) std::filesystem::remove_all(path + ext);
   }
 };
 
@@ -84,6 +85,27 @@ inline std::vector<std::string> rows(const std::string& lab, const std::string& 
     out.push_back(line);
   }
   return out;
+}
+
+// A run (killed and resumed, or started from a formed sample) against the run made in one
+// go: every series row, event, result and snapshot, and the final state's hash (not the
+// wall times some series and results measure).
+inline void expectSameRun(const std::string& reference, const std::string& other) {
+  for (const char* sql :
+       {"SELECT name, step, time_s, value FROM series WHERE name NOT LIKE '%seconds' ORDER BY "
+        "name, step",
+        "SELECT kind, step, stage, mode, x, y, z, particle_a, particle_b, granular, value FROM "
+        "events ORDER BY step, particle_a, particle_b, kind",
+        "SELECT name, value, unit FROM results WHERE name NOT LIKE '%seconds' ORDER BY name",
+        "SELECT text FROM messages WHERE text LIKE 'final state hash%' ORDER BY text",
+        "SELECT stage, label, step FROM snapshots ORDER BY step, label",
+        "SELECT status FROM runs"}) {
+    const auto a = rows(reference, sql), b = rows(other, sql);
+    EXPECT_EQ(a.size(), b.size()) << sql;
+    EXPECT_TRUE(a == b) << sql;
+  }
+  EXPECT_EQ(rows(other, "SELECT count(*) FROM messages WHERE text LIKE 'final state hash%'"),
+            std::vector<std::string>{"1|"});
 }
 
 // A campaign file beside `lab` over the quick hydrostatic protocol; `body` continues its

@@ -660,27 +660,6 @@ bool killDuringLoading(pid_t pid, const std::string& lab, double delay_s,
   return WIFSIGNALED(status);
 }
 
-// The killed and resumed run against the uninterrupted one: every series row, event,
-// result and wave, and the final state's hash (not the wall times some series and results
-// measure).
-void expectSameRun(const std::string& reference, const std::string& resumed) {
-  for (const char* sql :
-       {"SELECT name, step, time_s, value FROM series WHERE name NOT LIKE '%seconds' ORDER BY "
-        "name, step",
-        "SELECT kind, step, stage, mode, x, y, z, particle_a, particle_b, granular, value FROM "
-        "events ORDER BY step, particle_a, particle_b, kind",
-        "SELECT name, value, unit FROM results WHERE name NOT LIKE '%seconds' ORDER BY name",
-        "SELECT text FROM messages WHERE text LIKE 'final state hash%' ORDER BY text",
-        "SELECT stage, label, step FROM snapshots ORDER BY step, label",
-        "SELECT status FROM runs"}) {
-    const auto a = rows(reference, sql), b = rows(resumed, sql);
-    EXPECT_EQ(a.size(), b.size()) << sql;
-    EXPECT_TRUE(a == b) << sql;
-  }
-  EXPECT_EQ(rows(resumed, "SELECT count(*) FROM messages WHERE text LIKE 'final state hash%'"),
-            std::vector<std::string>{"1|"});
-}
-
 // `rocklab run` of a quick protocol on one thread, checkpointing every 0.2 s, with `sets`.
 std::vector<std::string> checkpointedRun(const std::string& protocol, const std::string& lab,
                                          const std::vector<std::string>& sets) {
@@ -721,10 +700,15 @@ double randomDelay(double lo, double hi) {
 
 // Runs `run(lab)` through, and again killed `lo` to `hi` s into its loading (its first
 // series named like `loading_series`); resumes the killed one on two threads and compares it
-// with the first. Returns what the resume printed.
+// with the first. Returns what the resume printed and the number of reference and resumed
+// runs that took a formed sample from the lab (formation.reuse).
+struct Resumed {
+  std::string out;
+  int from_formed = 0;
+};
 template <class Run>
-std::string killedAndResumed(const std::string& name, Run run, double lo, double hi,
-                             const std::string& loading_series = "loading.%") {
+Resumed killedAndResumed(const std::string& name, Run run, double lo, double hi,
+                         const std::string& loading_series = "loading.%") {
   Lab reference(name + "-reference"), killed(name + "-killed");
   std::string out;
   start(run(reference.path));
@@ -741,9 +725,14 @@ std::string killedAndResumed(const std::string& name, Run run, double lo, double
   } else {
     ADD_FAILURE() << "the run ended before it was killed";
   }
-  std::filesystem::remove_all(reference.path + ".files");
-  std::filesystem::remove_all(killed.path + ".files");
-  return out;
+  int from_formed = 0;
+  for (const Lab* lab : {&reference, &killed}) {
+    from_formed += std::stoi(rows(lab->path,
+                                  "SELECT count(*) FROM messages WHERE text LIKE "
+                                  "'formation.reuse: the sample formed by an earlier run%'")
+                                 .at(0));
+  }
+  return {out, from_formed};
 }
 
 }  // namespace resume
@@ -786,7 +775,7 @@ TEST(Protocols, AKilledRunResumesToTheUninterruptedRunOnceOrTwice) {
         rocklab::testing::runRocklab("resume 1 --quiet --threads 2 --lab " + killed.path, &out), 0)
         << out;
     EXPECT_NE(out.find("resumes from unit"), std::string::npos) << out;
-    resume::expectSameRun(reference.path, killed.path);
+    expectSameRun(reference.path, killed.path);
     // The completed run keeps no checkpoints and cannot be resumed again.
     EXPECT_FALSE(std::filesystem::exists(killed.path + ".files/run-1/checkpoints"));
     EXPECT_EQ(rocklab::testing::runRocklab("resume 1 --lab " + killed.path, &out), 2);
@@ -807,7 +796,7 @@ TEST(Protocols, AKilledRunResumesToTheUninterruptedRunOnceOrTwice) {
     waitpid(again, &status, 0);
     ASSERT_TRUE(WIFSIGNALED(status)) << "the resumed run ended before it was killed";
     ASSERT_EQ(rocklab::testing::runRocklab("resume 1 --quiet --lab " + twice.path, &out), 0) << out;
-    resume::expectSameRun(reference.path, twice.path);
+    expectSameRun(reference.path, twice.path);
   }
   for (const Lab* l : {&reference, &killed, &twice}) {
     std::filesystem::remove_all(l->path + ".files");
@@ -820,12 +809,33 @@ TEST(Protocols, AKilledDensityScaledLoadingResumesToTheUninterruptedRun) {
   resume::killedAndResumed("resume-scaled", resume::scaledHydrostatic, 0.0, 1.5);
 }
 
+// A run started from the lab's formed sample (formation.reuse) and killed in its loading
+// resumes to the uninterrupted run: the sample it took is in its own checkpoints.
+TEST(Protocols, ARunFromAFormedSampleKilledInItsLoadingResumes) {
+  Lab source("resume-formed-source");
+  const std::vector<std::string> sets = {"sample.count=600", "formation.reuse=true"};
+  resume::start(resume::checkpointedRun("hydrostatic-quick", source.path, sets));
+  int status = 0;
+  wait(&status);
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  auto fromFormed = [&](const std::string& lab) {
+    std::filesystem::copy(
+        source.path + ".formed", lab + ".formed",
+        std::filesystem::copy_options::recursive | std::filesystem::copy_options::skip_existing);
+    std::vector<std::string> with = sets;
+    with.push_back("loading.unload_to_MPa=8");  // another loading than the source's
+    return resume::checkpointedRun("hydrostatic-quick", lab, with);
+  };
+  EXPECT_EQ(resume::killedAndResumed("resume-formed", fromFormed, 0.0, 1.0).from_formed, 2);
+}
+
 // The permeameter killed in its axial loading: the loading loop resumes from its own
 // checkpoint, with the pore networks and the pressures on the particles as they were.
 TEST(Protocols, APermeameterKilledInItsLoadingResumesToTheUninterruptedRun) {
   // The loading takes about 8 s of the run's 10 (one thread): past 0.5 s it has checkpointed.
   const std::string out = resume::killedAndResumed("resume-flow", resume::quickPermeameter, 0.5,
-                                                   3.0, "deviatoric_stress_MPa");
+                                                   3.0, "deviatoric_stress_MPa")
+                              .out;
   EXPECT_NE(out.find("(loading), mid"), std::string::npos) << out;
 }
 

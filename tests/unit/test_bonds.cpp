@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <numbers>
+#include <optional>
+#include <tuple>
 
 #include "lab/core/errors.hpp"
 #include "lab/core/random.hpp"
@@ -260,6 +263,86 @@ TEST(Cementing, StrengthDrawsAndNegativeHandling) {
     // Bonds start unloaded.
     for (const auto& l : B.load) EXPECT_EQ(l.fn, 0.0);
   }
+}
+
+// The peak stresses a bond carried (BondForces::trackPeaks) are exactly what its strengths
+// must exceed for it to hold: loaded along the same path, a bond a hair stronger than its
+// peaks holds, one a hair weaker breaks. In tension and in shear with a friction angle (the
+// cohesion it needed under compression).
+TEST(BondPeaks, AStrengthAboveThePeakHoldsAndOneBelowBreaks) {
+  const double phi = 30.0 * std::numbers::pi / 180.0, v = 0.01;
+  auto load = [&](BondedPair<3>& p) {
+    p.drive(V3::Zero(), -0.5e-6 / (500 * kDt) * p.n, V3::Zero(), V3::Zero(), 500);  // compress
+    p.drive(V3::Zero(), V3(0, v, 0), V3::Zero(), V3::Zero(), 300);                  // shear
+    p.drive(V3::Zero(), v * p.n, V3::Zero(), V3::Zero(), 900);                      // pull
+  };
+  auto kind = [&](double tensile, double cohesion) {
+    BondKind k = cement(tensile, cohesion);
+    k.friction_angle = phi;
+    return k;
+  };
+  BondedPair<3> probe(kind(1e11, 1e11));
+  probe.sim.trackBondPeaks(true);
+  load(probe);
+  ASSERT_NE(probe.sim.bondPeaks(), nullptr);
+  const double tensile = probe.sim.bondPeaks()->tensile[0];
+  const double cohesion = probe.sim.bondPeaks()->cohesion[0];
+  EXPECT_GT(tensile, 0.0);
+  EXPECT_GT(cohesion, 0.0);
+  const double up = 1.0 + 1e-9, down = 1.0 - 1e-9;
+  for (const auto& [t, c, holds] : {std::tuple{tensile * up, cohesion * up, true},
+                                    std::tuple{tensile * down, cohesion * up, false},
+                                    std::tuple{tensile * up, cohesion * down, false}}) {
+    BondedPair<3> p(kind(t, c));
+    load(p);
+    EXPECT_EQ(p.sim.bonds().size(), holds ? 1u : 0u) << t << " " << c;
+  }
+  // A bond removed: the peaks name other bonds, and are gone.
+  BondedPair<3> weak(kind(tensile * down, cohesion * up));
+  weak.sim.trackBondPeaks(true);
+  load(weak);
+  EXPECT_EQ(weak.sim.bondPeaks(), nullptr);
+}
+
+// Strengths drawn again (redrawStrengths) from the stream reseeded as cementing began are the
+// draws cementing with the new kind makes, bit for bit, and the stream ends where it would.
+TEST(Cementing, StrengthsDrawnAgainAreThoseOfCementingWithTheNewKind) {
+  std::vector<V3> lattice;
+  for (int x = 0; x < 6; ++x) {
+    for (int y = 0; y < 6; ++y) lattice.push_back(2 * kR * V3(x, y, 0));
+  }
+  auto kind = [](double mean, NegativeStrength negative) {
+    BondKind k = cement(mean, 0.5 * mean);
+    k.tensile_std = k.shear_std = 4e6;
+    k.negative = negative;
+    return k;
+  };
+  auto cemented = [&](const BondKind& k) {
+    auto sim = std::make_unique<Simulation<3>>(
+        testing::table(testing::linearMaterial(1e6, 1e6, 0.5)), testing::undamped());
+    for (const V3& x : lattice) testing::addParticle<3>(*sim, x, kR, V3::Zero());
+    sim->rng().reseed(7);
+    sim->cement(sim->addBondKind(k), 0.05);
+    return sim;
+  };
+  const BondKind weak = kind(4e6, NegativeStrength::Resample);
+  const BondKind strong = kind(9e6, NegativeStrength::Resample);
+  auto redrawn = cemented(weak);
+  redrawn->rng().reseed(7);
+  const std::optional<std::size_t> again = redrawn->redrawStrengths(0, strong);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_GT(*again, 0u);  // the weak mean's draws <= 0 drawn again: the counts differ
+  const auto fresh = cemented(strong);
+  EXPECT_EQ(redrawn->bonds().tensile, fresh->bonds().tensile);
+  EXPECT_EQ(redrawn->bonds().shear, fresh->bonds().shear);
+  EXPECT_EQ(redrawn->rng().uniform(), fresh->rng().uniform());
+  EXPECT_EQ(redrawn->bondKinds()[0].tensile_mean, 9e6);
+  // A kind that skips draws <= 0 would have left a bond out: nothing changes.
+  const std::vector<double> before = redrawn->bonds().tensile;
+  redrawn->rng().reseed(7);
+  EXPECT_FALSE(redrawn->redrawStrengths(0, kind(1e6, NegativeStrength::Skip)).has_value());
+  EXPECT_EQ(redrawn->bonds().tensile, before);
+  EXPECT_EQ(redrawn->bondKinds()[0].tensile_mean, 9e6);
 }
 
 // A bonded pair whose order in the particle arrays flips (reordering at neighbour rebuilds)
