@@ -491,7 +491,9 @@ int campaignTask(const CampaignOptions& o) {
   }
   // The formed samples (formation.reuse) of the lab the campaign runs for, which all its
   // tasks share: the shard folder is campaignDir(lab, name).
-  std::string lab = fs::path(fs::absolute(o.shard_dir)).lexically_normal().parent_path().string();
+  fs::path shards = fs::absolute(o.shard_dir).lexically_normal();
+  if (!shards.has_filename()) shards = shards.parent_path();  // given with a trailing '/'
+  std::string lab = shards.parent_path().string();
   if (lab.ends_with(".campaigns")) lab.resize(lab.size() - std::string_view(".campaigns").size());
   const std::string formed = rigs::formedSamplesDir(lab);
   int code = 0;

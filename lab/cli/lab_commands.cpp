@@ -194,6 +194,19 @@ class SkippedWhileReplaying : public rigs::Recorder {
   const rigs::RunControl& control_;
 };
 
+// The name of a run's formed sample (formation.reuse): its formation's keys, the files they
+// name by their bytes (a sample file edited in place, or another one under the same name, is
+// another sample), and this very build by its bytes (a dirty build keeps its revision's
+// name: the formed samples outlive builds).
+std::string formationKey(const protocol::Settings& settings) {
+  std::string identity = rigs::formationIdentity(settings);
+  for (const notebook::InputFile& f : inputsOf(settings)) {
+    identity += f.key + " sha256 = " + notebook::fileSha256(f.path) + "\n";
+  }
+  static const std::string build = notebook::fileSha256("/proc/self/exe");
+  return notebook::hashText(identity + "build sha256 = " + build);
+}
+
 rigs::Journal::Options journalOptions(const protocol::Settings& settings) {
   rigs::Journal::Options o;
   o.every_s = settings.real("output.checkpoint_every_s");
@@ -247,8 +260,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
   control.setJournal(&*journal);
   if (settings.flag("formation.reuse")) {
     control.setFormedSamples(
-        {formed_dir.empty() ? rigs::formedSamplesDir(lab) : formed_dir,
-         notebook::hashText(rigs::formationIdentity(settings) + "code = " + kGitRevision)});
+        {formed_dir.empty() ? rigs::formedSamplesDir(lab) : formed_dir, formationKey(settings)});
   }
   NotebookRecorder notebook_rec(*writer);
   SkippedWhileReplaying replay_rec(notebook_rec, control);

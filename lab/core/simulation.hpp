@@ -204,6 +204,7 @@ class Simulation {
   // the neighbour skin like motion, so the list is rebuilt only when needed.
   void scaleRadii(double factor);
   void setLocalDamping(double alpha) { config_.local_damping = alpha; }
+  void setThreads(int threads) { config_.threads = threads; }  // the results do not change
   void setBondBreakage(bool on) { config_.bond_breakage = on; }
   void setFixedTimeStep(double dt);
   // Density scaling from now on (TimeStepConfig::density_scaling; 1: the physical masses

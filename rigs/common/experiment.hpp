@@ -43,7 +43,7 @@ class Interrupted : public std::runtime_error {
 // Where a lab keeps its formed samples (formed_samples.hpp), and the name of this run's.
 struct FormedSamples {
   std::string dir;  // beside the lab: formedSamplesDir()
-  std::string key;  // the hash of formationIdentity() and the code version
+  std::string key;  // the hash of formationIdentity(), its files and the build
   std::string file() const { return dir + "/" + key + ".formed"; }
 };
 

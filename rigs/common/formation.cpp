@@ -153,9 +153,7 @@ void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control) {
     const std::uint64_t formation = settle(sp, "formation", forming, control);
     steps = densification + formation;
     if (keep) {
-      const std::string why =
-          capture.complete() ? keepFormed(*store, sp, densification, formation, capture.records())
-                             : "the formation recorded more than its series and messages";
+      const std::string why = keepFormed(*store, sp, densification, formation, capture);
       if (!why.empty()) {
         rec.message(sim.steps(), sim.time(), "info",
                     "formation.reuse: the formed sample is not kept: " + why);

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -103,12 +105,16 @@ void FormationCapture::wave(const WaveRecord& w) {
 template <int D>
 std::string keepFormed(const FormedSamples& store, const Specimen<D>& sp,
                        std::uint64_t densification_steps, std::uint64_t formation_steps,
-                       const FormationRecords& records) {
+                       const FormationCapture& capture) {
   const auto& sim = *sp.sim;
   std::vector<double> tensile, cohesion;
   if (sp.grain_kind) {
     if (sim.bondKinds()[*sp.grain_kind].model != BondModel::Parallel) {
       return "the grains' bonds are flat joints, whose strengths cannot be drawn again";
+    }
+    if (sp.grain_bonds.skipped_nonpositive > 0) {
+      return "grain strength draws <= 0 left bonds out (grain_bonds.negative_strength = skip): "
+             "another run's draws would name other bonds";
     }
     if (sim.brokenBonds(*sp.grain_kind, BondBreakMode::Tensile) +
             sim.brokenBonds(*sp.grain_kind, BondBreakMode::Shear) >
@@ -119,6 +125,7 @@ std::string keepFormed(const FormedSamples& store, const Specimen<D>& sp,
     if (!peaks) return "the grain bonds' peak stresses were not kept through the formation";
     tensile = peaks->tensile, cohesion = peaks->cohesion;
   }
+  if (!capture.complete()) return "the formation recorded more than its series and messages";
   ArchiveWriter w;
   w("format", std::string(kFormat));
   w("key", store.key);
@@ -127,10 +134,14 @@ std::string keepFormed(const FormedSamples& store, const Specimen<D>& sp,
   w("formation_steps", formation_steps);
   w("peak_tensile", tensile);
   w("peak_cohesion", cohesion);
-  w("records", records);
+  w("records", capture.records());
   std::error_code ec;
   fs::create_directories(store.dir, ec);
-  const std::string tmp = store.file() + ".tmp-" + std::to_string(getpid());
+  // Named by host and process: tasks on other nodes of a cluster write to the same folder.
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  const std::string tmp =
+      store.file() + ".tmp-" + std::string(host) + "-" + std::to_string(getpid());
   {
     std::ofstream out(tmp, std::ios::binary);
     out.write(w.bytes().data(), static_cast<std::streamsize>(w.bytes().size()));
@@ -178,12 +189,14 @@ std::optional<Specimen<D>> reuseFormed(const FormedSamples& store, const Specime
     r("peak_tensile", tensile);
     r("peak_cohesion", cohesion);
     r("records", origin.records);
-  } catch (const CheckpointError& e) {
+    if (!r.atEnd()) throw CheckpointError("it goes on past its last field");
+  } catch (const std::exception& e) {  // a damaged file may also fail to allocate
     why = store.file() + " cannot be read (" + e.what() + "): this run forms it anew";
     return std::nullopt;
   }
   sp.settings = s;
   auto& sim = *sp.sim;
+  sim.setThreads(s.simulation.threads);  // the run's, not the forming run's
   // The stream as the run's own build left it: its grain strengths drawn in bond order.
   sim.rng().reseed(bondStream(s));
   if (sp.grain_kind) {
@@ -201,14 +214,17 @@ std::optional<Specimen<D>> reuseFormed(const FormedSamples& store, const Specime
       why = store.file() + " holds no peak stress for each bond: this run forms it anew";
       return std::nullopt;
     }
-    // Held at every step iff stronger than the peak; the relative margin covers the rounding
-    // of the cohesion a frictional bond needed (its peak is the shear stress less c tan(phi)
-    // as the pass rounded it).
+    // Held at every step iff stronger than the peak. A frictional bond's peak is its shear
+    // stress less its strength's frictional part as the pass rounded c + sigma_n tan(phi);
+    // the margin, relative to the larger of the stress and the strength, covers that
+    // rounding (the frictional part is at most the shear stress the bond carried).
     constexpr double kMargin = 1e-12;
+    auto above = [&](double strength, double peak) {
+      return strength > peak + kMargin * std::max(std::abs(peak), std::abs(strength));
+    };
     for (std::size_t b = 0; b < B.size(); ++b) {
       if (B.kind[b] != *sp.grain_kind) continue;
-      const bool holds = B.tensile[b] > tensile[b] + kMargin * std::abs(tensile[b]) &&
-                         B.shear[b] > cohesion[b] + kMargin * std::abs(cohesion[b]);
+      const bool holds = above(B.tensile[b], tensile[b]) && above(B.shear[b], cohesion[b]);
       if (!holds) {
         why = "grain bond " + std::to_string(b) +
               " of this run is weaker than a stress it carried while the sample formed: its "
@@ -225,7 +241,7 @@ std::optional<Specimen<D>> reuseFormed(const FormedSamples& store, const Specime
 
 #define ROCKLAB_FORMED(D)                                                                     \
   template std::string keepFormed<D>(const FormedSamples&, const Specimen<D>&, std::uint64_t, \
-                                     std::uint64_t, const FormationRecords&);                 \
+                                     std::uint64_t, const FormationCapture&);                 \
   template std::optional<Specimen<D>> reuseFormed<D>(const FormedSamples&,                    \
                                                      const SpecimenSettings&, std::string&);
 ROCKLAB_FORMED(2)

@@ -62,12 +62,12 @@ class FormationCapture : public Recorder {
 
 // Keeps a sample at the end of its formation for later runs: `sp` with its grain bonds' peak
 // stresses (the simulation tracked them from the formation's start), the steps of the
-// densification and of the formation, and the records. Written whole or not at all (a
-// temporary file renamed). Returns why it was not kept, empty when it was.
+// densification and of the formation, and the records captured. Written whole or not at all
+// (a temporary file renamed). Returns why it was not kept, empty when it was.
 template <int D>
 std::string keepFormed(const FormedSamples& store, const Specimen<D>& sp,
                        std::uint64_t densification_steps, std::uint64_t formation_steps,
-                       const FormationRecords& records);
+                       const FormationCapture& capture);
 
 // The lab's formed sample for these settings, with the run's own grain strengths drawn again,
 // or nothing: `why` then says why not (no sample formed yet, a bond weaker than the stress it

@@ -79,6 +79,21 @@ TEST(FormedSamples, WeakerGrainsOrAnotherFormationFormTheirOwnSample) {
       << out;
   EXPECT_EQ(messages(other, "formation.reuse: no sample of this formation%"), 1);
   EXPECT_EQ(std::distance(fs::directory_iterator(other.path + ".formed"), {}), 2);
+  // Grains that left bonds out (draws <= 0 skipped) keep no sample: another run's draws
+  // would name other bonds.
+  Lab skipping("formed-skipping");
+  ASSERT_EQ(runRocklab(smallUcs(" --set grain_bonds.negative_strength=skip --set "
+                                "grain_bonds.tensile_strength_mean_MPa=5 --set "
+                                "grain_bonds.tensile_strength_std_MPa=5") +
+                           " --lab " + skipping.path,
+                       &out),
+            0)
+      << out;
+  EXPECT_EQ(messages(skipping,
+                     "formation.reuse: the formed sample is not kept: grain strength "
+                     "draws <= 0 left bonds out%"),
+            1);
+  EXPECT_FALSE(fs::exists(skipping.path + ".formed"));
 }
 
 // The tasks of a campaign (each in its own process and shard) share the lab's formed
