@@ -37,11 +37,6 @@ bool afterFormation(const std::string& key) {
   return key.starts_with("bonds.") || keys.count(key) > 0;
 }
 
-// The bonds' stream of a build (buildSpecimen reseeds the scene's random stream with it).
-std::uint64_t bondStream(const SpecimenSettings& s) {
-  return static_cast<std::uint64_t>(s.protocol.seed) ^ 0x5eedb0d5ull;
-}
-
 }  // namespace
 
 std::string formedSamplesDir(const std::string& lab) {

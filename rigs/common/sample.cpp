@@ -171,7 +171,7 @@ Specimen<D> buildSpecimen(const SpecimenSettings& s, RunControl& control) {
   sp.sim = std::make_unique<Simulation<D>>(materials(s.material, s.formation.friction), config);
   auto& sim = *sp.sim;
   sim.particles().thickness = s.sample.packing.thickness;
-  sim.rng().reseed(static_cast<std::uint64_t>(s.protocol.seed) ^ 0x5eedb0d5ull);  // bonds' stream
+  sim.rng().reseed(bondStream(s));
   std::vector<ParticleId> ids;
   for (std::size_t i = 0; i < p.centers.size(); ++i) {
     ParticleSpec<D> ps;

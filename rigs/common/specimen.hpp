@@ -77,4 +77,10 @@ struct Specimen {
 template <int D>
 Specimen<D> buildSpecimen(const SpecimenSettings& s, RunControl& control);
 
+// The seed of the scene's random stream the bonds' strengths are drawn from (buildSpecimen
+// reseeds with it; a reused formed sample draws its grains' strengths again from it).
+inline std::uint64_t bondStream(const SpecimenSettings& s) {
+  return static_cast<std::uint64_t>(s.protocol.seed) ^ 0x5eedb0d5ull;
+}
+
 }  // namespace rocklab::rigs
