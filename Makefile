@@ -157,7 +157,8 @@ oedometer: build
 	  --vary numerics.timestep_safety=0.25,0.5,0.8
 	$(gallery_png)
 biaxial: build
-	$(STUDY) protocols/biaxial-ucs-quick.toml --vary loading.axial_strain_rate_per_s=2.5,5,10,20
+	$(STUDY) protocols/biaxial-ucs-quick.toml \
+	  --vary loading.axial_strain_rate_per_s=0.15625,0.3125,0.625,1.25
 	$(gallery_png)
 envelope: build
 	$(STUDY) protocols/triaxial-envelope-quick.toml \

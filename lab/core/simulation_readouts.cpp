@@ -53,7 +53,20 @@ std::string Simulation<D>::diagnose() const {
   int causes = 0;
 
   const double crit = criticalTimeStep();
-  if (std::isfinite(crit) && dt_ > crit) {
+  const double scaling = config_.timestep.density_scaling;
+  if (scaling > 1.0 && config_.timestep.automatic) {
+    // Scaled masses put every scaled particle's own bound at the step over the safety factor
+    // (automaticStep): the estimate of the physical masses says nothing then. Where the
+    // particles are alike (a lattice, one size) they reach the bound together, and their
+    // coupled modes are faster than any one particle's own estimate.
+    ++causes;
+    s << "Likely cause: density scaling (numerics.density_scaling = " << scaling
+      << ") steps each scaled particle at its own stability bound times the safety factor ("
+      << config_.timestep.safety
+      << "); where the particles are alike, as in a lattice, they reach it together and move "
+         "less stably than each alone. Lower numerics.density_scaling or "
+         "numerics.timestep_safety.\n";
+  } else if (std::isfinite(crit) && dt_ > crit) {
     ++causes;
     s << "Likely cause: the time step " << dt_ << " s is above the critical estimate " << crit
       << " s (particle mass and contact stiffness); use automatic stepping or lower the "

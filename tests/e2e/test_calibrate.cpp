@@ -25,7 +25,7 @@ std::string calibrationFile(const Lab& lab, const std::string& name, double ucs,
                       << "\"\nbudget = 12\nbatch = 2\nseeds = 2\n"
                       << extra << "\n[set]\n\"sample.count\" = 60\n\n[[target]]\nprotocol = \""
                       << sourceDir()
-                      << "/protocols/biaxial-ucs-quick.toml\"\nresult = \"ucs_MPa\"\nvalue = "
+                      << "/protocols/biaxial-ucs-hand-set.toml\"\nresult = \"ucs_MPa\"\nvalue = "
                       << ucs << "\ntolerance_percent = 4\n\n[[parameter]]\nname = \"cement\"\n"
                       << "keys = { \"bonds.tensile_strength_mean_MPa\" = 1.0, "
                          "\"bonds.shear_strength_mean_MPa\" = 1.0 }\nlow = 5.0\nhigh = 100.0\n"
@@ -146,7 +146,7 @@ TEST(Calibrate, GoesOnAfterAKillChecksTheBestPointAndWritesAMaterialProtocolsInc
   EXPECT_EQ(text.find("count"), std::string::npos) << text;  // [set], but not the material's
   const std::string protocol = lab.path + ".material/ucs.toml";
   {
-    std::ifstream p(sourceDir() + "/protocols/biaxial-ucs-quick.toml");
+    std::ifstream p(sourceDir() + "/protocols/biaxial-ucs-hand-set.toml");
     std::string original(std::istreambuf_iterator<char>(p), {});
     for (const char* key :
          {"tensile_strength_mean_MPa = 33.0\n", "shear_strength_mean_MPa = 33.0\n"}) {

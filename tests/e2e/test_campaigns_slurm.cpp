@@ -158,7 +158,7 @@ TEST_F(SlurmCluster, ACalibrationRunsItsBatchesAsJobArrays) {
   std::ofstream(file) << "[calibration]\nname = \"slurm-cement\"\nbudget = 4\nbatch = 2\nseeds = "
                          "2\n\n[set]\n\"sample.count\" = 60\n\n[[target]]\nprotocol = \""
                       << sourceDir()
-                      << "/protocols/biaxial-ucs-quick.toml\"\nresult = \"ucs_MPa\"\nvalue = "
+                      << "/protocols/biaxial-ucs-hand-set.toml\"\nresult = \"ucs_MPa\"\nvalue = "
                          "6.0\ntolerance_percent = 10\n\n[[parameter]]\nkey = "
                          "\"bonds.tensile_strength_mean_MPa\"\nlow = 5.0\nhigh = 100.0\nscale = "
                          "\"log\"\nstart = 16.5\n\n[slurm]\npartition = \"debug\"\ntime = "

@@ -103,22 +103,26 @@ axial_stress_MPa = 10
 lateral_stress_MPa = 5
 )";
 
-// Li & Holt section 2.3: the superparticle sample's UCS is 9.9 MPa (calibrated: measured
-// 9.80 MPa on the quick sample; +-25% allows for another seed of 250 grains).
+// Li & Holt section 2.3: the superparticle sample's UCS is 9.9 MPa, what its material was
+// calibrated to at the paper's 1,500 grains (materials/superparticle-2d.toml). The quick
+// sample's 500 grains sit lower, and one of them scatters more: over the reference's 8 seeds
+// (tests/reference/biaxial-ucs-quick.toml) 7.91 MPa, 0.8 of the calibration's 9.95 at 1,500
+// grains, with a standard deviation of 1.25 MPa. Held to 0.8 x 9.9 within two of those.
 TEST(QuickProtocols, SuperparticleSampleHasThePapersUcs) {
   Lab lab("ucs");
   nb::Notebook n = runQuick(lab, "biaxial-ucs-quick");
   EXPECT_EQ(scalar(n, "SELECT status FROM runs"), "completed");
-  EXPECT_NEAR(result(n, "ucs_MPa"), 9.9, 0.25 * 9.9);
+  EXPECT_NEAR(result(n, "ucs_MPa"), 0.8 * 9.9, 2 * 1.25);
   // Grains as generated: irregular, every one below the aspect limit (measured mean 1.26).
   EXPECT_LT(result(n, "grain_aspect_ratio_max"), 1.5);
   EXPECT_GT(result(n, "grain_aspect_ratio_mean"), 1.1);
-  // Zero confinement: the lateral walls keep clear (judged against 1 MPa; measured 0.65%).
+  // Zero confinement: the lateral walls keep clear (judged against 1 MPa; measured 0.7%).
   EXPECT_LT(result(n, "confining_stress_error_max"), 0.01);
-  // Unconfined, the cement fails, the grains stay whole (measured: 46 cement breaks, none
-  // inside grains).
-  EXPECT_GT(result(n, "broken_bonds_tensile"), result(n, "broken_bonds_shear"));
-  EXPECT_LE(result(n, "crushed_grains"), 2.0);
+  // Unconfined, the cement fails, mainly in tension, and few grains crush (at 1,500 grains the
+  // calibration's runs broke 4 to 6 times as many cement bonds in tension as in shear and
+  // crushed 1.1-2.1% of their grains).
+  EXPECT_GT(result(n, "broken_bonds_tensile"), 2 * result(n, "broken_bonds_shear"));
+  EXPECT_LT(result(n, "crushed_grains"), 0.05 * result(n, "grains"));
 }
 
 // Li & Holt Figure 6 from one sweep: the Mohr-Coulomb line through the dilatant critical
@@ -954,7 +958,7 @@ TEST(Protocols, EveryRigRunsOnASampleFromAFile) {
       {"hydrostatic-quick", "s3.txt", " --set formation.enabled=false", s3.radii.size()},
       {"permeameter-hydrostatic-3d-quick", "s3.data", "", s3.radii.size()},
       {"ultrasonic-hydrostatic-quick", "s3.yade", "", s3.radii.size()},
-      {"biaxial-ucs-quick", "h2.vtp", "", h2.radii.size()},
+      {"biaxial-ucs-hand-set", "h2.vtp", "", h2.radii.size()},
       {"triaxial-envelope-quick", "h2.txt", "", h2.radii.size()},
   };
   int cemented = 0;
@@ -1027,6 +1031,21 @@ TEST(Protocols, EveryRigRunsOnASampleFromAFile) {
             2);
   EXPECT_NE(out.find("bad.csv:3: column z: 'x' is not a finite number"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(lab.path + ".bad"));
+  // A hard case: the lattice of disks loaded density-scaled 4 times (biaxial-ucs-quick) has
+  // every disk stepping at its bound at once, and goes unstable (at 2 it does not, nor at 4
+  // with a safety factor of 0.3). The run stops, failed, and the diagnosis names the scaling.
+  const Lab scaled("files-scaled");
+  EXPECT_EQ(rocklab::testing::runRocklab("run " + sourceDir() +
+                                             "/protocols/biaxial-ucs-quick.toml --quiet --threads "
+                                             "1 --set sample.kind=file --set sample.file=" +
+                                             dir + "/h2.vtp --lab " + scaled.path,
+                                         &out),
+            1)
+      << out;
+  EXPECT_NE(out.find("Likely cause: density scaling (numerics.density_scaling = 4)"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(rows(scaled.path, "SELECT status FROM runs"), std::vector<std::string>{"failed|"});
   std::filesystem::remove_all(dir);
   std::filesystem::remove_all(lab.path + ".files");
 }

@@ -200,9 +200,11 @@ class CalibrationFile : public ::testing::Test {
            ("rocklab-calibration-" +
             std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    fs::create_directories(dir_ / "materials");
+    // The quick twins with the protocols they vary and the material those include.
     for (const char* p :
-         {"biaxial-ucs-quick.toml", "brazilian-2d-quick.toml", "brazilian-2d.toml"}) {
+         {"biaxial-ucs-quick.toml", "biaxial-ucs.toml", "materials/superparticle-2d.toml",
+          "brazilian-2d-quick.toml", "brazilian-2d.toml"}) {
       fs::copy_file(fs::path(ROCKLAB_SOURCE_DIR) / "protocols" / p, dir_ / p);
     }
   }

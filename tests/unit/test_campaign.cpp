@@ -23,7 +23,7 @@ class CampaignFile : public ::testing::Test {
         ("rocklab-campaign-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
          "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
-    fs::copy_file(fs::path(ROCKLAB_SOURCE_DIR) / "protocols/biaxial-ucs-quick.toml",
+    fs::copy_file(fs::path(ROCKLAB_SOURCE_DIR) / "protocols/biaxial-ucs-hand-set.toml",
                   dir_ / "ucs.toml");
   }
   void TearDown() override { fs::remove_all(dir_); }
