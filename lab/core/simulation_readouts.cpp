@@ -52,7 +52,6 @@ std::string Simulation<D>::diagnose() const {
   for (double r : P.radius) rmin = std::min(rmin, r);
   int causes = 0;
 
-  const double crit = criticalTimeStep();
   const double scaling = config_.timestep.density_scaling;
   if (scaling > 1.0 && config_.timestep.automatic) {
     // Scaled masses put every scaled particle's own bound at the step over the safety factor
@@ -66,7 +65,7 @@ std::string Simulation<D>::diagnose() const {
       << "); where the particles are alike, as in a lattice, they reach it together and move "
          "less stably than each alone. Lower numerics.density_scaling or "
          "numerics.timestep_safety.\n";
-  } else if (std::isfinite(crit) && dt_ > crit) {
+  } else if (const double crit = criticalTimeStep(); std::isfinite(crit) && dt_ > crit) {
     ++causes;
     s << "Likely cause: the time step " << dt_ << " s is above the critical estimate " << crit
       << " s (particle mass and contact stiffness); use automatic stepping or lower the "
