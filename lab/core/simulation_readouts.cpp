@@ -55,16 +55,15 @@ std::string Simulation<D>::diagnose() const {
   const double scaling = config_.timestep.density_scaling;
   if (scaling > 1.0 && config_.timestep.automatic) {
     // Scaled masses put every scaled particle's own bound at the step over the safety factor
-    // (automaticStep): the estimate of the physical masses says nothing then. Where the
-    // particles are alike (a lattice, one size) they reach the bound together, and their
-    // coupled modes are faster than any one particle's own estimate.
+    // (automaticStep): the estimate of the physical masses says nothing then, and a stiffening
+    // between two estimates (contacts closing fast, a stiffer material) takes the scaled
+    // particles past their bound together.
     ++causes;
     s << "Likely cause: density scaling (numerics.density_scaling = " << scaling
       << ") steps each scaled particle at its own stability bound times the safety factor ("
       << config_.timestep.safety
-      << "); where the particles are alike, as in a lattice, they reach it together and move "
-         "less stably than each alone. Lower numerics.density_scaling or "
-         "numerics.timestep_safety.\n";
+      << "), so a stiffening between two estimates of the step takes them past it together. "
+         "Lower numerics.density_scaling or numerics.timestep_safety.\n";
   } else if (const double crit = criticalTimeStep(); std::isfinite(crit) && dt_ > crit) {
     ++causes;
     s << "Likely cause: the time step " << dt_ << " s is above the critical estimate " << crit

@@ -186,6 +186,41 @@ TEST(HardCases, AutomaticStepFollowsHertzStiffening) {
   EXPECT_GT(smallest_ratio, 1.0);
 }
 
+// Under density scaling the scaled particles step at their own bounds times the safety
+// factor, so a stiffening the step has not been estimated for takes them past it together.
+// Contacts 50 times stiffer between two estimates: the run stops, and the diagnosis names
+// the scaling (the physical masses' critical step, always below the scaled step, would
+// mislead).
+TEST(HardCases, AStiffeningUnderDensityScalingIsDiagnosedAsTheScaling) {
+  PackingSpec spec;
+  spec.count = 800;
+  spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
+  spec.porosity = 0.37;  // beyond jamming: every particle is loaded
+  const Packing<3> p = generatePacking<3>(spec);
+  SimulationConfig cfg = testing::undamped();
+  cfg.contact_law = "hertz";
+  cfg.timestep.density_scaling = 4.0;
+  cfg.timestep.update_interval = 1000000;  // no estimate after the first
+  Simulation<3> sim(testing::table(testing::hertzMaterial(1e9, 0.25, 0.5)), cfg);
+  for (std::size_t i = 0; i < p.centers.size(); ++i) {
+    testing::addParticle<3>(sim, p.centers[i], p.radii[i], V3::Zero());
+  }
+  testing::addBox<3>(sim, p.lo, p.hi);
+  ASSERT_NO_THROW(sim.run(200));
+  sim.replaceMaterials(testing::table(testing::hertzMaterial(5e10, 0.25, 0.5)));
+  try {
+    sim.run(100000);
+    FAIL() << "a step beyond the scaled particles' bounds ran to the end";
+  } catch (const SimulationUnstable& e) {
+    const std::string why = e.what();
+    EXPECT_NE(why.find("Likely cause: density scaling (numerics.density_scaling = 4)"),
+              std::string::npos)
+        << why;
+    EXPECT_EQ(why.find("above the critical estimate"), std::string::npos) << why;
+    EXPECT_TRUE(allFinite(sim));
+  }
+}
+
 // A brittle sample at high stress: cemented while squeezed (every contact overlapping), with
 // strengths of little scatter, then unloaded at once (the walls move away). The bonds take
 // the strain energy the contacts release and fail in a cascade, most of them within a few

@@ -87,6 +87,25 @@ TEST(DensityScaling, TheStepIsTheFactorTimesTheCriticalOneAndNoParticleIsLessSta
   EXPECT_GT(sim.inertialMassRatio(), 1.0);
 }
 
+// Cement put in after the step was set stiffens every bonded particle: the step and the
+// inertial masses are estimated again at once, not at the next update (every 100 steps). A
+// sample cemented under density scaling stepped until then at the bound of its contacts
+// alone, its scaled particles all at that bound: a lattice of equal disks (the test of
+// samples from files, density-scaled 4 times) went unstable 11 steps into its loading.
+TEST(DensityScaling, CementingEstimatesTheStepAgainAtOnce) {
+  Cell c(4.0);
+  c.settle();
+  auto& sim = *c.sim;
+  const double before = sim.dt();
+  BondKind cement;
+  cement.modulus = 2e9;  // twice the contacts' modulus: the bonds carry most of the stiffness
+  ASSERT_GT(sim.cement(sim.addBondKind(cement), 0.05).installed, 500u);
+  const double target = 4.0 * sim.criticalTimeStep();  // of the physical masses, bonds and all
+  EXPECT_LT(sim.dt(), 0.8 * before);
+  EXPECT_DOUBLE_EQ(sim.dt(), sim.config().timestep.safety * target);
+  EXPECT_NEAR(scaledCriticalStep(sim), target, 1e-9 * target);
+}
+
 // Equilibrium does not depend on inertia: the servo-held sample settles to the same porosity
 // and stresses in fewer steps.
 TEST(DensityScaling, TheSampleSettlesToTheSameEquilibriumInFewerSteps) {
