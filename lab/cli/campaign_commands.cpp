@@ -1,6 +1,5 @@
 #include "lab/cli/campaign_commands.hpp"
 
-#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 
 #include "lab/campaign/campaign.hpp"
 #include "lab/campaign/ledger.hpp"
+#include "lab/cli/child_process.hpp"
 #include "lab/cli/lab_commands.hpp"
 #include "lab/notebook/merge.hpp"
 #include "reports/campaign_report.hpp"
@@ -87,12 +87,9 @@ std::vector<std::string> checkTasks(const campaign::Campaign& c) {
   return hashes;
 }
 
-// What a notebook is on disk besides its file's name.
-constexpr const char* kNotebookParts[] = {"", "-wal", "-shm", ".files"};
-
 // Moves a notebook (closed) and its files; across file systems by copying.
 void moveNotebook(const std::string& from, const std::string& to) {
-  for (const std::string suffix : kNotebookParts) {
+  for (const std::string suffix : notebook::kNotebookParts) {
     const fs::path a = from + suffix, b = to + suffix;
     if (!fs::exists(a)) continue;
     fs::remove_all(b);
@@ -103,10 +100,6 @@ void moveNotebook(const std::string& from, const std::string& to) {
       fs::remove_all(a);
     }
   }
-}
-
-void removeNotebook(const std::string& path) {
-  for (const std::string suffix : kNotebookParts) fs::remove_all(path + suffix);
 }
 
 // Where a task's shard was made: what its task wrote beside it (the scheduler's ids).
@@ -146,7 +139,7 @@ campaign::TaskState collectShard(notebook::Notebook& lab, campaign::TaskState t,
     t.reason = q.text(2);
   }
   if (status == "completed") {
-    removeNotebook(shard);
+    notebook::removeNotebook(shard);
     for (const char* ext : {".log", ".origin"}) {
       fs::remove(dir + "/task-" + std::to_string(t.task.index) + ext);
     }
@@ -202,27 +195,9 @@ class Progress {
 
 // `rocklab campaign task` as a child process, its output to the task's log.
 pid_t spawnTask(const campaign::Campaign& c, const std::string& dir, int task) {
-  const std::string exe = fs::read_symlink("/proc/self/exe").string();
-  const std::vector<std::string> args = {
-      exe,      "campaign",           "task",        fs::absolute(c.file).string(),
-      "--task", std::to_string(task), "--shard-dir", dir,
-      "--quiet"};
-  const std::string log = dir + "/task-" + std::to_string(task) + ".log";
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      dup2(fd, STDOUT_FILENO);
-      dup2(fd, STDERR_FILENO);
-    }
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(exe.c_str(), argv.data());
-    _exit(127);
-  }
-  if (pid < 0) throw std::runtime_error("cannot start a task process (fork failed)");
-  return pid;
+  return spawnLogged({selfExecutable(), "campaign", "task", fs::absolute(c.file).string(), "--task",
+                      std::to_string(task), "--shard-dir", dir, "--quiet"},
+                     dir + "/task-" + std::to_string(task) + ".log");
 }
 
 // What is left to run: not completed, and (unless asked to rerun them) not failed.
@@ -369,7 +344,7 @@ int runSlurm(const CampaignOptions& o, const Opened& x) {
   }
   const std::vector<campaign::TaskState> queue = toRun(states, o.rerun_failed);
   if (queue.empty()) return summary(c, states);
-  const std::string exe = fs::read_symlink("/proc/self/exe").string();
+  const std::string exe = selfExecutable();
   const std::string file = fs::absolute(c.file).string();
   // Each task runs on its node's local storage ($TMPDIR) and moves its shard to the
   // campaign's folder when it ends: a SQLite file is never written over a network file system.
@@ -480,7 +455,7 @@ int campaignTask(const CampaignOptions& o) {
     return 1;
   }
   if (status == "completed") return 0;
-  if (!fs::exists(shard + ".files/run-1/checkpoints/journal")) removeNotebook(shard);
+  if (!fs::exists(shard + ".files/run-1/checkpoints/journal")) notebook::removeNotebook(shard);
   // On local storage when asked, under the shard's own name (its files' paths name it).
   std::string work = shard;
   if (!o.scratch.empty()) {
@@ -506,7 +481,7 @@ int campaignTask(const CampaignOptions& o) {
     r.formed_dir = formed;
     code = resumeRun(1, r);
     fresh = code == 2;  // it cannot resume (its protocol or rocklab changed): run it anew
-    if (fresh) removeNotebook(work);
+    if (fresh) notebook::removeNotebook(work);
   }
   if (fresh) {
     try {

@@ -461,6 +461,9 @@ void addRegress(CLI::App& app, Action& action) {
                   "Seeds per protocol, from its own (the check's interval narrows with them)")
       ->check(CLI::Range(2, 100));
   rgu->add_option("--threads", u->threads, "Threads of every run")->check(CLI::Range(1, 1024));
+  rgu->add_option("--jobs", u->jobs,
+                  "Runs at once, each a process of its own whose notebook is merged into the lab")
+      ->check(CLI::Range(1, 256));
   rgu->callback([&action, u] { action = [u] { return rocklab::cli::regressUpdate(*u); }; });
 }
 

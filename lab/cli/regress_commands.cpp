@@ -1,7 +1,12 @@
 #include "lab/cli/regress_commands.hpp"
 
+#include <sys/wait.h>
+
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,7 +17,9 @@
 
 #include "lab/campaign/statistics.hpp"
 #include "lab/cli/build_info.hpp"
+#include "lab/cli/child_process.hpp"
 #include "lab/cli/lab_commands.hpp"
+#include "lab/notebook/merge.hpp"
 #include "reports/key_results.hpp"
 #include "reports/run_data.hpp"
 
@@ -214,6 +221,12 @@ int regressCheck(const std::string& reference, const std::string& lab, std::int6
 namespace {
 
 // A protocol run at `seeds` seeds from its own; the runs' data, or fewer when one failed.
+std::atomic<int> g_stop{0};
+extern "C" void onUpdateSignal(int sig) {
+  g_stop.store(sig);
+}
+
+// The runs at the seeds in this process, one after the other.
 std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const std::string& file,
                                          const RegressUpdateOptions& o, bool& interrupted) {
   const std::int64_t seed0 = c.settings.integer("protocol.seed");
@@ -233,6 +246,95 @@ std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const s
     }
     notebook::Notebook nb(o.lab);
     runs.push_back(reports::loadRun(nb, r.run));
+  }
+  return runs;
+}
+
+// The runs at the seeds `jobs` at a time (--jobs), each `rocklab run` in a process of its own
+// into a shard notebook beside the lab (<lab>.regress/), merged into the lab when it ends, as
+// a campaign's tasks are: a reference of eight slow runs in a quarter of the time on 4 cores.
+// A signal stops starting runs and reaches the running ones, which end interrupted, their
+// data merged all the same.
+std::vector<reports::RunData> runAtSeedsAtOnce(const rigs::CheckedProtocol& c,
+                                               const std::string& file,
+                                               const RegressUpdateOptions& o, bool& interrupted) {
+  const std::int64_t seed0 = c.settings.integer("protocol.seed");
+  const std::string dir = std::filesystem::absolute(o.lab).string() + ".regress";
+  std::filesystem::create_directories(dir);
+  auto shard = [&](int k) {
+    return dir + "/" + c.settings.text("protocol.name") + "-seed-" + std::to_string(seed0 + k);
+  };
+  notebook::Notebook lab(o.lab);
+  std::vector<std::optional<reports::RunData>> done(static_cast<std::size_t>(o.seeds));
+  std::map<pid_t, int> running;
+  bool failed = false;
+  int next = 0, forwarded = 0;
+  g_stop.store(0);
+  std::signal(SIGINT, onUpdateSignal);
+  std::signal(SIGTERM, onUpdateSignal);
+  while (next < o.seeds || !running.empty()) {
+    while (g_stop.load() == 0 && !failed && next < o.seeds &&
+           static_cast<int>(running.size()) < o.jobs) {
+      std::vector<std::string> args = {selfExecutable(),
+                                       "run",
+                                       std::filesystem::absolute(file).string(),
+                                       "--quiet",
+                                       "--set",
+                                       "protocol.seed=" + std::to_string(seed0 + next),
+                                       "--lab",
+                                       shard(next) + ".sqlite"};
+      if (o.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.threads)});
+      notebook::removeNotebook(shard(next) + ".sqlite");  // a shard an earlier update left
+      running[spawnLogged(args, shard(next) + ".log")] = next;
+      ++next;
+    }
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (g_stop.load() != 0 && forwarded == 0) {  // a kill of this process alone
+      forwarded = g_stop.load();
+      for (const auto& r : running) kill(r.first, forwarded);
+    }
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    const auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const int k = it->second;
+    running.erase(it);
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    const std::string notebook_file = shard(k) + ".sqlite";
+    if (std::filesystem::exists(notebook_file)) {
+      try {
+        const notebook::MergeOutcome m = notebook::mergeNotebook(lab, notebook_file, {});
+        if (code == 0 && !m.runs.empty()) done[k] = reports::loadRun(lab, m.runs.back());
+        notebook::removeNotebook(notebook_file);
+      } catch (const std::exception& e) {  // the shard stays, for `rocklab notebook merge`
+        std::cerr << notebook_file << " is not merged into the lab: " << e.what() << "\n";
+      }
+    }
+    if (done[k]) std::filesystem::remove(shard(k) + ".log");
+    if (code == 130 || g_stop.load() != 0) {
+      interrupted = true;
+    } else if (!done[k]) {
+      failed = true;
+      std::cerr << file << ": the run at seed " << seed0 + k
+                << " did not complete (its output: " << shard(k)
+                << ".log): no reference written for it\n";
+    }
+  }
+  if (interrupted) {
+    std::cerr << file << ": interrupted; the runs so far are in " << o.lab
+              << " (their output: " << dir << ")\n";
+  }
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  std::error_code kept;  // the folder goes when no shard or log is left in it
+  std::filesystem::remove(dir, kept);
+  std::vector<reports::RunData> runs;
+  for (auto& r : done) {
+    if (!r) break;
+    runs.push_back(std::move(*r));
   }
   return runs;
 }
@@ -313,7 +415,8 @@ int regressUpdate(const RegressUpdateOptions& o) {
   bool failed = false;
   for (std::size_t p = 0; p < checked.size(); ++p) {
     bool interrupted = false;
-    const auto runs = runAtSeeds(checked[p], o.protocols[p], o, interrupted);
+    const auto runs = o.jobs > 1 ? runAtSeedsAtOnce(checked[p], o.protocols[p], o, interrupted)
+                                 : runAtSeeds(checked[p], o.protocols[p], o, interrupted);
     if (interrupted) return 130;
     if (runs.size() < static_cast<std::size_t>(o.seeds)) {
       failed = true;

@@ -25,6 +25,7 @@ struct RegressUpdateOptions {
   std::string lab = "lab.sqlite";
   int seeds = 8;
   int threads = 0;
+  int jobs = 1;  // runs at once, each a process of its own (1: in this one)
 };
 // Runs each protocol at `seeds` seeds (its own and the next ones) and writes
 // out/<protocol name>.toml.

@@ -199,4 +199,8 @@ MergeOutcome mergeNotebook(Notebook& into, const std::string& source, const Prov
   return out;
 }
 
+void removeNotebook(const std::string& path) {
+  for (const std::string suffix : kNotebookParts) fs::remove_all(path + suffix);
+}
+
 }  // namespace rocklab::notebook

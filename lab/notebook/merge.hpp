@@ -32,4 +32,9 @@ struct MergeOutcome {
 // it with rocklab would), then only read.
 MergeOutcome mergeNotebook(Notebook& into, const std::string& source, const Provenance& origin);
 
+// What a notebook is on disk besides its file's name: its journal and its runs' files.
+inline constexpr const char* kNotebookParts[] = {"", "-wal", "-shm", ".files"};
+// Removes a (closed) notebook and its files, as a merged shard is.
+void removeNotebook(const std::string& path);
+
 }  // namespace rocklab::notebook

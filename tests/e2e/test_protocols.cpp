@@ -758,6 +758,61 @@ TEST(Protocols, SigtermLeavesAnInterruptedRunWithItsData) {
   EXPECT_NE(scalar(n, "SELECT count(*) FROM series"), "0");
 }
 
+// `regress update --jobs 2` runs the seeds two at a time, each in a process of its own whose
+// notebook is merged into the lab: the same reference file as one run after the other (every
+// value, bit for bit), the runs in the lab with the shard each came from, no shard left. A
+// SIGTERM to the update alone reaches its runs: it ends with 130 and writes no reference, its
+// runs interrupted in the lab with what they recorded.
+TEST(Protocols, RegressUpdateRunsTheSeedsAtOnceToTheSameReference) {
+  Lab one("update-one"), two("update-two"), stopped("update-stopped");
+  const std::string protocol = writeProtocol(
+      "tiny-ucs", "base = \"" + sourceDir() +
+                      "/protocols/biaxial-ucs-hand-set.toml\"\n[protocol]\nname = \"tiny-ucs\"\n"
+                      "[sample]\ncount = 60\n");
+  auto update = [&](const Lab& lab, const std::string& jobs) {
+    std::string out;
+    EXPECT_EQ(rocklab::testing::runRocklab("regress update " + protocol +
+                                               " --seeds 2 --threads 1 --out " + lab.path +
+                                               ".ref --lab " + lab.path + jobs,
+                                           &out),
+              0)
+        << out;
+    std::ifstream in(lab.path + ".ref/tiny-ucs.toml");
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  const std::string sequential = update(one, ""), at_once = update(two, " --jobs 2");
+  EXPECT_NE(sequential.find("seeds = [1, 2]"), std::string::npos) << sequential;
+  EXPECT_EQ(at_once, sequential);
+  EXPECT_EQ(rows(two.path, "SELECT seed, status FROM runs ORDER BY seed"),
+            (std::vector<std::string>{"1|completed|", "2|completed|"}));
+  EXPECT_EQ(rows(two.path,
+                 "SELECT count(*) FROM run_origins WHERE notebook LIKE "
+                 "'%.regress/tiny-ucs-seed-_.sqlite'"),
+            std::vector<std::string>{"2|"});
+  EXPECT_FALSE(std::filesystem::exists(two.path + ".regress"));
+
+  const pid_t pid =
+      resume::start({"regress", "update", protocol, "--seeds", "2", "--threads", "1", "--jobs", "2",
+                     "--out", stopped.path + ".ref", "--lab", stopped.path});
+  ASSERT_TRUE(resume::recording(pid, stopped.path + ".regress/tiny-ucs-seed-1.sqlite", "%"));
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_FALSE(std::filesystem::exists(stopped.path + ".ref/tiny-ucs.toml"));
+  EXPECT_EQ(rows(stopped.path, "SELECT status FROM runs WHERE seed = 1"),
+            std::vector<std::string>{"interrupted|"});
+  EXPECT_NE(rows(stopped.path,
+                 "SELECT count(*) FROM series s JOIN runs r ON r.id = s.run_id "
+                 "WHERE r.seed = 1"),
+            std::vector<std::string>{"0|"});
+  for (const Lab* lab : {&one, &two, &stopped}) {
+    std::filesystem::remove_all(lab->path + ".ref");
+    std::filesystem::remove_all(lab->path + ".regress");
+  }
+  std::filesystem::remove(protocol);
+}
+
 // A run killed (SIGKILL) at a random moment of its loading and resumed ends as the run that
 // was never killed: the same final state, every record once (the delay after the loading's
 // first records is drawn anew each time; it is printed when the test fails).
