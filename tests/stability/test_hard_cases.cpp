@@ -105,19 +105,25 @@ TEST(HardCases, StiffnessContrastTenThousand) {
   EXPECT_LT(sim.dt(), sim.criticalTimeStep());
 }
 
-Simulation<3> densePack(double dt_factor) {
+// 800 Hertz spheres in a box, beyond jamming: every particle is loaded.
+Simulation<3> densePackScene(SimulationConfig cfg) {
   PackingSpec spec;
   spec.count = 800;
   spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
-  spec.porosity = 0.37;  // beyond jamming: every particle is loaded
+  spec.porosity = 0.37;
   const Packing<3> p = generatePacking<3>(spec);
-  SimulationConfig cfg = testing::undamped();
   cfg.contact_law = "hertz";
   Simulation<3> sim(testing::table(testing::hertzMaterial(1e9, 0.25, 0.5)), cfg);
   for (std::size_t i = 0; i < p.centers.size(); ++i) {
     testing::addParticle<3>(sim, p.centers[i], p.radii[i], V3::Zero());
   }
   testing::addBox<3>(sim, p.lo, p.hi);
+  return sim;
+}
+
+// The dense pack undamped, at a fixed step of dt_factor times the critical one.
+Simulation<3> densePack(double dt_factor) {
+  Simulation<3> sim = densePackScene(testing::undamped());
   sim.step();
   sim.setFixedTimeStep(dt_factor * sim.criticalTimeStep());
   return sim;
@@ -192,20 +198,10 @@ TEST(HardCases, AutomaticStepFollowsHertzStiffening) {
 // the scaling (the physical masses' critical step, always below the scaled step, would
 // mislead).
 TEST(HardCases, AStiffeningUnderDensityScalingIsDiagnosedAsTheScaling) {
-  PackingSpec spec;
-  spec.count = 800;
-  spec.sizes = SizeDistribution::uniform(1.6e-3, 2.4e-3);
-  spec.porosity = 0.37;  // beyond jamming: every particle is loaded
-  const Packing<3> p = generatePacking<3>(spec);
   SimulationConfig cfg = testing::undamped();
-  cfg.contact_law = "hertz";
   cfg.timestep.density_scaling = 4.0;
   cfg.timestep.update_interval = 1000000;  // no estimate after the first
-  Simulation<3> sim(testing::table(testing::hertzMaterial(1e9, 0.25, 0.5)), cfg);
-  for (std::size_t i = 0; i < p.centers.size(); ++i) {
-    testing::addParticle<3>(sim, p.centers[i], p.radii[i], V3::Zero());
-  }
-  testing::addBox<3>(sim, p.lo, p.hi);
+  Simulation<3> sim = densePackScene(cfg);
   ASSERT_NO_THROW(sim.run(200));
   sim.replaceMaterials(testing::table(testing::hertzMaterial(5e10, 0.25, 0.5)));
   try {
