@@ -1454,12 +1454,14 @@ TEST(QuickProtocols, UltrasonicAnisotropyAfterFailureIsLargestInUniaxialStrain) 
   EXPECT_LT(inclined_broken[5], lateral_broken[5]);
 
   // Figure 18c: under 2.85 MPa confinement the same strain leaves less anisotropy (the
-  // confinement keeps the cracks across the axis closed): from 3 millistrain on, the drop
-  // of vp_x below vp_z's is smaller at every stage than in uniaxial strain, and a
-  // millistrain or two after that sample's failure it keeps at most 0.65 of it (4
-  // millistrain, measured 0.063 against 0.105; 0.44-0.60 over seeds 3-5). Later the lateral
-  // stress of uniaxial strain climbs toward the confinement (2.2 MPa at 6 millistrain) and
-  // the two tests converge. The triaxial sample fails too, and vp_x falls.
+  // confinement keeps the cracks across the axis closed): from 3 to 5 millistrain the drop of
+  // vp_x below vp_z's is smaller at every stage than in uniaxial strain, and a millistrain or
+  // two after that sample's failure (4 millistrain) it is a fraction of it. Over seeds 1-5 that
+  // fraction is 0.36-0.67 (mean 0.52, sd 0.14; 0.665 at this protocol's seed 3, 0.0634 against
+  // 0.0954), so one seed is held below 0.85, 2.4 sd above the mean. Later the lateral stress of
+  // uniaxial strain climbs toward the confinement (2.2 MPa at 6 millistrain) and the two tests
+  // converge: at 6 millistrain the triaxial drop passes the other at seeds 1 and 2. The
+  // triaxial sample fails too, and vp_x falls.
   Lab tri_lab("ultrasonic-triaxial");
   auto t = runQuick(tri_lab, "ultrasonic-triaxial-quick");
   EXPECT_EQ(scalar(t, "SELECT status FROM runs"), "completed");
@@ -1471,9 +1473,9 @@ TEST(QuickProtocols, UltrasonicAnisotropyAfterFailureIsLargestInUniaxialStrain) 
   auto anisotropy = [](const std::vector<double>& z, const std::vector<double>& x, std::size_t k) {
     return z[k] / z[0] - x[k] / x[0];
   };
-  for (std::size_t k = 2; k < 6; ++k) {
+  for (std::size_t k = 2; k < 5; ++k) {
     EXPECT_LT(anisotropy(tz, tx, k), anisotropy(pz, px, k)) << "stage " << k + 1;
   }
   EXPECT_GT(anisotropy(pz, px, 3), 0.08);
-  EXPECT_LT(anisotropy(tz, tx, 3), 0.65 * anisotropy(pz, px, 3));
+  EXPECT_LT(anisotropy(tz, tx, 3), 0.85 * anisotropy(pz, px, 3));
 }
