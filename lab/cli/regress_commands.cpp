@@ -220,13 +220,13 @@ int regressCheck(const std::string& reference, const std::string& lab, std::int6
 
 namespace {
 
-// A protocol run at `seeds` seeds from its own; the runs' data, or fewer when one failed.
 std::atomic<int> g_stop{0};
 extern "C" void onUpdateSignal(int sig) {
   g_stop.store(sig);
 }
 
-// The runs at the seeds in this process, one after the other.
+// A protocol run at `seeds` seeds from its own; the runs' data, or fewer when one failed.
+// Here the runs are in this process, one after the other.
 std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const std::string& file,
                                          const RegressUpdateOptions& o, bool& interrupted) {
   const std::int64_t seed0 = c.settings.integer("protocol.seed");
@@ -290,7 +290,7 @@ std::vector<reports::RunData> runAtSeedsAtOnce(const rigs::CheckedProtocol& c,
     }
     int status = 0;
     const pid_t pid = waitpid(-1, &status, 0);
-    if (g_stop.load() != 0 && forwarded == 0) {  // a kill of this process alone
+    if (g_stop.load() != 0 && forwarded == 0) {  // reaches the runs if sent to this process alone
       forwarded = g_stop.load();
       for (const auto& r : running) kill(r.first, forwarded);
     }
