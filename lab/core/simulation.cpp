@@ -580,11 +580,20 @@ void Simulation<D>::step() {
   }
   const StageClock clock(&stages_[kGuard]);
   guard(overlap);
-  if (config_.timestep.automatic &&
-      step_ % static_cast<std::uint64_t>(config_.timestep.update_interval) == 0) {
-    const double dt = automaticStep();
-    if (std::isfinite(dt)) dt_ = dt;
+  if (step_ % static_cast<std::uint64_t>(config_.timestep.update_interval) == 0) {
+    estimateStepAgain();
   }
+}
+
+template <int D>
+void Simulation<D>::estimateStepAgain() {
+  if (!config_.timestep.automatic) return;
+  if (!prepared_) {
+    dt_ = 0.0;  // prepare() estimates it
+    return;
+  }
+  const double dt = automaticStep();
+  if (std::isfinite(dt)) dt_ = dt;  // no free particle left: the last step stays
 }
 
 template <int D>
@@ -634,13 +643,7 @@ void Simulation<D>::setDensityScaling(double factor) {
     const std::vector<double> unbounded(particles_.size(), INFINITY);
     setInertialMasses(unbounded, 0.0);
   }
-  if (!config_.timestep.automatic) return;
-  if (prepared_) {
-    const double dt = automaticStep();
-    if (std::isfinite(dt)) dt_ = dt;
-  } else {
-    dt_ = 0.0;  // prepare() sets it for the new scaling
-  }
+  estimateStepAgain();
 }
 
 template <int D>

@@ -211,7 +211,9 @@ class Simulation {
   // back, as a wave window needs). Takes effect at once when the simulation is prepared.
   void setDensityScaling(double factor);
   // Replaces the materials (e.g. the friction after forming a sample); contact history and
-  // bonds stay. The table must keep the indices particles and walls use.
+  // bonds stay. The table must keep the indices particles and walls use. The step stays until
+  // its next estimate: the rigs change the friction alone, and a resumed run changes it again
+  // after its checkpoint, where an estimate would part it from the run never stopped.
   void replaceMaterials(MaterialTable materials);
   // A deep copy through the checkpoint serializer (a branch of an experiment, a wave
   // measurement on a copy of a loaded sample); stage timings start anew.
@@ -351,6 +353,10 @@ class Simulation {
   // The automatic step: safety times the critical estimate, or under density scaling times
   // its target, with the inertial masses set for it.
   double automaticStep();
+  // After a change of stiffness or scaling: the automatic step and the inertial masses
+  // estimated now when the simulation is prepared, else left to prepare() (the contact model
+  // the estimate needs may be gone with the materials).
+  void estimateStepAgain();
   void setInertialMasses(const std::vector<double>& limits, double target);
   void computeBondForces(double dt);
   void applyGravity(double dt);

@@ -177,13 +177,11 @@ CementReport Simulation<D>::cement(std::uint8_t kind_index, double gap_ratio) {
     }
   }
   bond_forces_.invalidate();
-  // The bonds stiffen the particles they join: the step and the inertial masses follow now,
-  // not at the next estimate. Under density scaling the scaled particles sit at their bound,
-  // so until then they would step beyond it (a cemented lattice went unstable so).
-  if (prepared_ && config_.timestep.automatic && report.installed > 0) {
-    const double dt = automaticStep();
-    if (std::isfinite(dt)) dt_ = dt;
-  }
+  // The bonds stiffen the particles they join: the step and the inertial masses follow at
+  // once (or at prepare()), not at the next estimate. Under density scaling the scaled particles
+  // sit at their bound, so until then they would step beyond it (a cemented lattice went unstable
+  // so).
+  if (report.installed > 0) estimateStepAgain();
   return report;
 }
 

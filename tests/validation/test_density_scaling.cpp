@@ -106,6 +106,29 @@ TEST(DensityScaling, CementingEstimatesTheStepAgainAtOnce) {
   EXPECT_NEAR(scaledCriticalStep(sim), target, 1e-9 * target);
 }
 
+// The same when the simulation is not prepared as the bonds go in: a rig gives the grains
+// their own friction just before it cements them (Simulation::replaceMaterials), and the
+// contact model the estimate needs is gone until the next step prepares it. That step is the
+// bonded sample's, not the one the contacts alone allowed.
+TEST(DensityScaling, CementingWhileUnpreparedLeavesTheStepToPrepare) {
+  Cell c(4.0);
+  c.settle();
+  auto& sim = *c.sim;
+  const double before = sim.dt();
+  MaterialTable own;
+  for (const Material& m : sim.materials().all()) own.add(m);
+  own[0].friction = 0.3;
+  sim.replaceMaterials(std::move(own));
+  BondKind cement;
+  cement.modulus = 2e9;
+  ASSERT_GT(sim.cement(sim.addBondKind(cement), 0.05).installed, 500u);
+  sim.prepare();
+  const double target = 4.0 * sim.criticalTimeStep();
+  EXPECT_LT(sim.dt(), 0.8 * before);
+  EXPECT_DOUBLE_EQ(sim.dt(), sim.config().timestep.safety * target);
+  EXPECT_NEAR(scaledCriticalStep(sim), target, 1e-9 * target);
+}
+
 // Equilibrium does not depend on inertia: the servo-held sample settles to the same porosity
 // and stresses in fewer steps.
 TEST(DensityScaling, TheSampleSettlesToTheSameEquilibriumInFewerSteps) {
