@@ -321,6 +321,17 @@ class Simulation {
   std::vector<ContactForce> contactForces() const;
   // Mean unbalanced force over mean contact force (PFC's equilibrium measure).
   double unbalancedForceRatio() const;
+  // Mean speed (m/s) of the free particles and clumps: whether the sample is at rest, which
+  // the unbalanced forces do not tell of a sample straining as a whole.
+  double meanSpeed() const;
+  // The first moment of the unbalanced forces about `origin`, per axis a: the sum over the
+  // free particles and clumps of (x - origin)_a F_a, F the contact, bond and wall forces on
+  // each (its weight and applied load left out). A box of walls holding the sample: its wall
+  // stress (compression positive, the mean of each axis's two walls about the box's centre)
+  // plus this over its volume is the Love-Weber average stress of the contents, the sum of
+  // branch vector times force over the contacts (Love 1927; Weber 1966). The two differ by
+  // the bodies' inertia and damping, the walls' reading of a sample that is not balanced.
+  V unbalancedForceMoment(const V& origin) const;
   const ContactStore<D>& contacts() const { return contacts_; }
   std::vector<StageTiming> stageTimings() const;
   // FNV-1a hash of the dynamic state, to compare runs bit for bit.

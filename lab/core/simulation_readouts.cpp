@@ -311,6 +311,51 @@ double Simulation<D>::unbalancedForceRatio() const {
 }
 
 template <int D>
+double Simulation<D>::meanSpeed() const {
+  const auto& P = particles_;
+  double sum = 0.0;
+  std::size_t free = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
+    sum += P.vel[i].norm();
+    ++free;
+  }
+  for (std::size_t c = 0; c < clumps_.size(); ++c) {
+    if (!clumps_.alive[c]) continue;
+    sum += clumps_.vel[c].norm();
+    ++free;
+  }
+  return free ? sum / static_cast<double>(free) : 0.0;
+}
+
+template <int D>
+typename Simulation<D>::V Simulation<D>::unbalancedForceMoment(const V& origin) const {
+  const auto& P = particles_;
+  V g;
+  for (int d = 0; d < D; ++d) g[d] = config_.gravity[d];
+  const auto applied = [&](std::size_t i) {
+    const std::uint32_t slot = P.slot_of[i];
+    return slot < applied_.size() ? applied_[slot] : V(V::Zero());
+  };
+  V moment = V::Zero();
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;  // clumps: whole bodies
+    const V f = P.force[i] - g / P.physical_inv_mass[i] - applied(i);
+    moment += V((P.pos[i] - origin).array() * f.array());
+  }
+  const auto& K = clumps_;
+  for (std::uint32_t c = 0; c < K.size(); ++c) {
+    if (!K.alive[c]) continue;
+    V f = K.force[c] - K.mass[c] * g;
+    for (std::uint32_t k = K.first[c]; k < K.first[c + 1]; ++k) {
+      f -= applied(P.indexOfSlot(K.member_slot[k]));
+    }
+    moment += V((K.pos[c] - origin).array() * f.array());
+  }
+  return moment;
+}
+
+template <int D>
 std::vector<StageTiming> Simulation<D>::stageTimings() const {
   static constexpr const char* kNames[kStages] = {
       "integrate", "neighbors", "body_forces", "contacts", "bonds", "wall_servo", "guard"};
@@ -335,6 +380,8 @@ std::vector<StageTiming> Simulation<D>::stageTimings() const {
   template std::vector<Simulation<D>::ContactForce> Simulation<D>::contactForces() const; \
   template double Simulation<D>::coordinationNumber() const;                              \
   template double Simulation<D>::unbalancedForceRatio() const;                            \
+  template Vec<D> Simulation<D>::unbalancedForceMoment(const Vec<D>&) const;              \
+  template double Simulation<D>::meanSpeed() const;                                       \
   template std::vector<StageTiming> Simulation<D>::stageTimings() const;
 ROCKLAB_READOUTS(2)
 ROCKLAB_READOUTS(3)

@@ -21,6 +21,7 @@ struct LoadingTest {
   double axial_strain_max = 0.05;
   double stop_after_drop = 0.0;
   double stop_after_drop_min_strain = 0.002;
+  double rest_speed_ratio = 0.0;
   RateBoost boost;  // rigs/common/adaptive_rate.hpp
 
   template <class F>
@@ -29,6 +30,11 @@ struct LoadingTest {
                        "stress rate from the formation state to the confinement"});
     f(seating_stress, {"seating_stress_MPa", units::MPa, Range::closed(0, 1e3),
                        "axial stress above the confinement the platens keep before loading"});
+    f(rest_speed_ratio,
+      {"rest_speed_ratio", units::none, Range::closed(0, 10),
+       "the confinement ends once the grains' mean speed is below this fraction of the "
+       "platens' speed at the axial strain rate, besides the stresses on target and the "
+       "balance (0: those alone)"});
     f(axial_strain_rate, loading_keys::kAxialStrainRate);
     f(axial_strain_max, loading_keys::kAxialStrainMax);
     f(stop_after_drop, loading_keys::kStopAfterDrop);

@@ -13,6 +13,9 @@ const Outputs& outputs() {
           .prefixes({"confinement."})
           .series({
               {"deviatoric_stress_MPa", "MPa", "q: axial minus mean lateral stress"},
+              {"interior_deviatoric_stress_MPa", "MPa",
+               "q of the contacts inside (Love-Weber): the walls' less the grains' inertia and "
+               "damping"},
               {"axial_strain_rate_per_s", "1/s",
                "the platens' strain rate (above the set one while loading.rate_boost_max > 1 "
                "and the sample is calm)"},

@@ -30,10 +30,13 @@ struct Settling {
 };
 
 // Runs the frame until the stresses hold and the sample is in equilibrium (or, with a
-// stall window, its porosity has stopped falling); returns the steps it took.
+// stall window, its porosity has stopped falling); returns the steps it took. Balance alone
+// does not see a sample that moves as a whole: one strained by a fast servo ramp keeps
+// straining after it, with small unbalanced forces. With `rest_speed` above 0 the grains'
+// mean speed must also have fallen below it.
 template <int D>
 std::uint64_t settle(Specimen<D>& sp, const std::string& stage, Recorder& rec, RunControl& control,
-                     const Stall& stall = {}) {
+                     const Stall& stall = {}, double rest_speed = 0.0) {
   Journal::Unit unit = control.unit("settle " + stage);
   Settling st{sp.sim->steps(), sp.frame->porosity()};
   std::uint64_t done = 0;
@@ -52,7 +55,8 @@ std::uint64_t settle(Specimen<D>& sp, const std::string& stage, Recorder& rec, R
     control.tick(stage, sim.steps(), -1.0,
                  "stress error " + fmt(err) + ", unbalanced force ratio " + fmt(u));
     const bool held = err < f.stress_tolerance;
-    if (held && u < f.unbalanced_force_ratio) {
+    if (held && u < f.unbalanced_force_ratio &&
+        (rest_speed <= 0.0 || sim.meanSpeed() < rest_speed)) {
       unit.finish(done, sp);
       return done;
     }
@@ -74,7 +78,12 @@ std::uint64_t settle(Specimen<D>& sp, const std::string& stage, Recorder& rec, R
       why << stage << " did not settle in " << done << " steps: the wall stresses miss their "
           << "targets by " << fmt(err) << " (formation.stress_tolerance " << f.stress_tolerance
           << "), the unbalanced force ratio is " << fmt(u) << " (formation.unbalanced_force_ratio "
-          << f.unbalanced_force_ratio << "); raise formation.max_steps or loosen the tolerances";
+          << f.unbalanced_force_ratio << ")";
+      if (rest_speed > 0.0) {
+        why << ", the grains' mean speed is " << fmt(sim.meanSpeed()) << " m/s (at rest below "
+            << fmt(rest_speed) << " m/s: loading.rest_speed_ratio of the platens' speed)";
+      }
+      why << "; raise formation.max_steps or loosen the tolerances";
       throw std::runtime_error(why.str());
     }
   }
@@ -203,7 +212,7 @@ struct Ramp {
 
 template <int D>
 void servoTo(Specimen<D>& sp, double axial, double lateral, double rate, const std::string& stage,
-             Recorder& rec, RunControl& control) {
+             Recorder& rec, RunControl& control, double rest_speed) {
   using Axis = typename LoadingFrame<D>::Axis;
   using Mode = typename LoadingFrame<D>::Mode;
   constexpr int ax = Specimen<D>::kAxial;
@@ -235,14 +244,14 @@ void servoTo(Specimen<D>& sp, double axial, double lateral, double rate, const s
     for (int a = 0; a < D; ++a) sp.frame->set(a, Axis{Mode::Stress, 0.0, r.to[a], 0.0});
     unit.finish(r, sp);
   }
-  settle(sp, stage, rec, control);
+  settle(sp, stage, rec, control, {}, rest_speed);
 }
 
 template void formAndCement<2>(Specimen<2>&, Recorder&, RunControl&);
 template void formAndCement<3>(Specimen<3>&, Recorder&, RunControl&);
 template void servoTo<2>(Specimen<2>&, double, double, double, const std::string&, Recorder&,
-                         RunControl&);
+                         RunControl&, double);
 template void servoTo<3>(Specimen<3>&, double, double, double, const std::string&, Recorder&,
-                         RunControl&);
+                         RunControl&, double);
 
 }  // namespace rocklab::rigs

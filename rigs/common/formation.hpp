@@ -16,10 +16,11 @@ template <int D>
 void formAndCement(Specimen<D>& sp, Recorder& rec, RunControl& control);
 
 // Moves the frame by servo from its present stresses to (axial, lateral) targets (Pa) at a
-// stress rate (Pa/s), and holds there until settled. Used by coring, reloading and
-// confinement.
+// stress rate (Pa/s), and holds there until settled: the stresses on target and the sample
+// in balance, and with `rest_speed` (m/s) above 0 the grains' mean speed below it. Used by
+// coring, reloading and confinement.
 template <int D>
 void servoTo(Specimen<D>& sp, double axial, double lateral, double rate, const std::string& stage,
-             Recorder& rec, RunControl& control);
+             Recorder& rec, RunControl& control, double rest_speed = 0.0);
 
 }  // namespace rocklab::rigs

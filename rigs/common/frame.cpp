@@ -51,6 +51,15 @@ double LoadingFrame<D>::stress(int axis) const {
 }
 
 template <int D>
+double LoadingFrame<D>::interiorStress(int axis) const {
+  Vec<D> centre;
+  for (int a = 0; a < D; ++a) {
+    centre[a] = 0.5 * (sim_->wall(2 * a).point[a] + sim_->wall(2 * a + 1).point[a]);
+  }
+  return stress(axis) + sim_->unbalancedForceMoment(centre)[axis] / volume();
+}
+
+template <int D>
 double LoadingFrame<D>::force(int axis) const {
   return stress(axis) * faceArea(axis);
 }

@@ -110,6 +110,75 @@ TEST(LoadingFrame, StressControlHoldsATargetOnFreeParticles) {
   EXPECT_LT(frame.stressError(), 0.01);
 }
 
+// A column of n spheres of radius kR on the bottom wall of a box twice their diameter wide
+// and a radius taller: only the bottom wall touches it.
+struct Column {
+  std::unique_ptr<Simulation<3>> sim;
+  std::unique_ptr<LoadingFrame<3>> frame;
+  int n;
+  Column(int n_, SimulationConfig cfg) : n(n_) {
+    cfg.timestep.automatic = false;
+    cfg.timestep.fixed_dt = 1e-6;
+    sim = std::make_unique<Simulation<3>>(testing::table(testing::linearMaterial(kKn, kKn, 0.0)),
+                                          cfg);
+    for (int k = 0; k < n; ++k) {
+      testing::addParticle<3>(*sim, kR * V3(2, 2, 1 + 2 * k), kR, V3::Zero());
+    }
+    frame = std::make_unique<LoadingFrame<3>>(*sim, V3::Zero(), kR * V3(4, 4, 2 * n + 1), 0);
+  }
+  double mass() const { return 1.0 / sim->particles().inv_mass[0]; }
+};
+
+// Love (1927), Weber (1966): the average stress of the contents is the sum over contacts of
+// branch vector times force over the volume. A column resting under its weight carries
+// (n - k) m g across its k-th contact, a diameter long, and n m g to the wall from its first
+// centre, a radius above it: m g r n^2 / V in all, where the walls read half the base load.
+TEST(LoadingFrame, InteriorStressOfAColumnUnderItsWeightIsItsAverageStress) {
+  SimulationConfig cfg;
+  cfg.local_damping = 0.7;
+  cfg.gravity = {0.0, 0.0, -9.81};
+  Column c(5, cfg);
+  for (int s = 0; s < 20000; ++s) c.frame->step();
+  ASSERT_LT(c.sim->unbalancedForceRatio(), 1e-6);  // at rest
+  const double mg = c.mass() * 9.81, n = c.n;
+  const double area = c.frame->faceArea(2);
+  EXPECT_NEAR(c.frame->stress(2), 0.5 * n * mg / area, 1e-6 * n * mg / area);
+  // The overlaps, n m g / kn at most, shorten the branches by a part in 10^5.
+  const double average = mg * kR * n * n / c.frame->volume();
+  EXPECT_NEAR(c.frame->interiorStress(2), average, 1e-4 * average);
+  EXPECT_NEAR(c.frame->interiorStress(0), 0.0, 1e-12 * average);  // nothing presses sideways
+}
+
+// Struck by the bottom platen the column is far from balance: the walls read the mean of
+// that platen's force and none, and the interior stress is still the Love-Weber sum over the
+// contacts as they are, branch times normal force between the spheres and centre-to-wall
+// times force at the walls.
+TEST(LoadingFrame, InteriorStressIsTheLoveWeberSumOfAColumnStruckByAPlaten) {
+  Column c(8, testing::undamped());
+  using Axis = LoadingFrame<3>::Axis;
+  using Mode = LoadingFrame<3>::Mode;
+  c.frame->set(2, Axis{Mode::StrainRate, 50.0});  // each platen at 0.43 m/s
+  for (int s = 0; s < 20; ++s) c.frame->step();   // the top one 1,000 steps away
+  const auto& P = c.sim->particles();
+  double sum = 0.0;
+  for (const auto& f : c.sim->contactForces())
+    sum += std::abs(P.pos[f.j][2] - P.pos[f.i][2]) * f.normal;
+  double lowest = INFINITY, highest = -INFINITY;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    lowest = std::min(lowest, P.pos[i][2]);
+    highest = std::max(highest, P.pos[i][2]);
+  }
+  const auto& bottom = c.sim->wall(4);
+  const auto& top = c.sim->wall(5);
+  sum += (lowest - bottom.point[2]) * bottom.force.norm() +
+         (top.point[2] - highest) * top.force.norm();
+  const double love_weber = sum / c.frame->volume();
+  ASSERT_EQ(top.force.norm(), 0.0);
+  ASSERT_GT(bottom.force.norm(), 0.0);
+  EXPECT_NEAR(c.frame->interiorStress(2), love_weber, 1e-9 * love_weber);
+  EXPECT_GT(std::abs(c.frame->stress(2) - love_weber), 0.1 * love_weber);
+}
+
 // The adaptive loading rate: up by 1.25 per calm window to its cap, back to the set rate at
 // once on a break or out of balance.
 TEST(AdaptiveRate, FastWhileCalmTheSetRateWhileItBreaks) {
