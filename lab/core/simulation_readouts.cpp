@@ -7,10 +7,36 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "lab/core/simulation_touching.hpp"
 
 namespace rocklab {
+
+namespace {
+
+// The sum of the norms of a per-particle vector over the free particles (clump pebbles left
+// out) and of a per-clump one over the live clumps, and how many bodies that is.
+template <class Particles, class Clumps, class PerParticle, class PerClump>
+std::pair<double, std::size_t> freeBodyNorms(const Particles& P, const Clumps& K,
+                                             const PerParticle& of_particle,
+                                             const PerClump& of_clump) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
+    sum += of_particle[i].norm();
+    ++count;
+  }
+  for (std::size_t c = 0; c < K.size(); ++c) {
+    if (!K.alive[c]) continue;
+    sum += of_clump[c].norm();
+    ++count;
+  }
+  return {sum, count};
+}
+
+}  // namespace
 
 template <int D>
 void Simulation<D>::guard(bool overlap_exceeded) {
@@ -288,18 +314,9 @@ template <int D>
 double Simulation<D>::unbalancedForceRatio() const {
   const auto& P = particles_;
   if (!model_) return 0.0;
-  double unbalanced = 0.0, contact = 0.0;
-  std::size_t free = 0, count = 0;
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
-    unbalanced += P.force[i].norm();
-    ++free;
-  }
-  for (std::size_t c = 0; c < clumps_.size(); ++c) {
-    if (!clumps_.alive[c]) continue;
-    unbalanced += clumps_.force[c].norm();
-    ++free;
-  }
+  const auto [unbalanced, free] = freeBodyNorms(P, clumps_, P.force, clumps_.force);
+  double contact = 0.0;
+  std::size_t count = 0;
   forEachTouching([&](const Touching& t) {
     if (t.wall) return;
     const double fn = model_->normalForce(t.mi, t.mj, t.overlap, t.shape);
@@ -312,19 +329,7 @@ double Simulation<D>::unbalancedForceRatio() const {
 
 template <int D>
 double Simulation<D>::meanSpeed() const {
-  const auto& P = particles_;
-  double sum = 0.0;
-  std::size_t free = 0;
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) continue;
-    sum += P.vel[i].norm();
-    ++free;
-  }
-  for (std::size_t c = 0; c < clumps_.size(); ++c) {
-    if (!clumps_.alive[c]) continue;
-    sum += clumps_.vel[c].norm();
-    ++free;
-  }
+  const auto [sum, free] = freeBodyNorms(particles_, clumps_, particles_.vel, clumps_.vel);
   return free ? sum / static_cast<double>(free) : 0.0;
 }
 

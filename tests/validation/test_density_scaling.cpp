@@ -92,18 +92,26 @@ TEST(DensityScaling, TheStepIsTheFactorTimesTheCriticalOneAndNoParticleIsLessSta
 // sample cemented under density scaling stepped until then at the bound of its contacts
 // alone, its scaled particles all at that bound: a lattice of equal disks (the test of
 // samples from files, density-scaled 4 times) went unstable 11 steps into its loading.
-TEST(DensityScaling, CementingEstimatesTheStepAgainAtOnce) {
+// `before` runs between the settling and the cementing.
+template <class Before>
+void expectTheBondedStepAfterCementing(Before before) {
   Cell c(4.0);
   c.settle();
   auto& sim = *c.sim;
-  const double before = sim.dt();
+  const double contacts_only = sim.dt();
+  before(sim);
   BondKind cement;
   cement.modulus = 2e9;  // twice the contacts' modulus: the bonds carry most of the stiffness
   ASSERT_GT(sim.cement(sim.addBondKind(cement), 0.05).installed, 500u);
+  sim.prepare();  // a prepared simulation: nothing; else the estimate comes here
   const double target = 4.0 * sim.criticalTimeStep();  // of the physical masses, bonds and all
-  EXPECT_LT(sim.dt(), 0.8 * before);
+  EXPECT_LT(sim.dt(), 0.8 * contacts_only);
   EXPECT_DOUBLE_EQ(sim.dt(), sim.config().timestep.safety * target);
   EXPECT_NEAR(scaledCriticalStep(sim), target, 1e-9 * target);
+}
+
+TEST(DensityScaling, CementingEstimatesTheStepAgainAtOnce) {
+  expectTheBondedStepAfterCementing([](Simulation<3>&) {});
 }
 
 // The same when the simulation is not prepared as the bonds go in: a rig gives the grains
@@ -111,22 +119,12 @@ TEST(DensityScaling, CementingEstimatesTheStepAgainAtOnce) {
 // contact model the estimate needs is gone until the next step prepares it. That step is the
 // bonded sample's, not the one the contacts alone allowed.
 TEST(DensityScaling, CementingWhileUnpreparedLeavesTheStepToPrepare) {
-  Cell c(4.0);
-  c.settle();
-  auto& sim = *c.sim;
-  const double before = sim.dt();
-  MaterialTable own;
-  for (const Material& m : sim.materials().all()) own.add(m);
-  own[0].friction = 0.3;
-  sim.replaceMaterials(std::move(own));
-  BondKind cement;
-  cement.modulus = 2e9;
-  ASSERT_GT(sim.cement(sim.addBondKind(cement), 0.05).installed, 500u);
-  sim.prepare();
-  const double target = 4.0 * sim.criticalTimeStep();
-  EXPECT_LT(sim.dt(), 0.8 * before);
-  EXPECT_DOUBLE_EQ(sim.dt(), sim.config().timestep.safety * target);
-  EXPECT_NEAR(scaledCriticalStep(sim), target, 1e-9 * target);
+  expectTheBondedStepAfterCementing([](Simulation<3>& sim) {
+    MaterialTable own;
+    for (const Material& m : sim.materials().all()) own.add(m);
+    own[0].friction = 0.3;
+    sim.replaceMaterials(std::move(own));
+  });
 }
 
 // Equilibrium does not depend on inertia: the servo-held sample settles to the same porosity
