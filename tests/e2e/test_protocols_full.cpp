@@ -20,14 +20,15 @@ namespace {
 
 using namespace rocklab::testing;
 
-// Figure 4 on the quick twin (500 grains of the calibrated material, its loading unscaled):
-// at 4 MPa the sample dilates to its peak and localises in a band inclined to sigma_1, the
-// cement breaking mainly in tension. Measured over seeds 1-5 (campaigns/
-// fewer-steps-shear-band-2d.toml, unscaled): tensile against shear breaks 163-554 against
-// 104-220; the band at 29.5-51.75 deg (mean 38.6, sd 9.0; the paper: about 35), so one seed is
-// held to 15-60 deg, about 2.5 sd either side, where a compaction band would be beyond 70;
-// its contrast 3.9-5.6. The rise of the shear breaks and the crushing from 4 to 18 MPa on one
-// material is the envelope sweep's (QuickProtocols.EnvelopeSweepGivesMohrCoulombLineAndCap).
+// Figure 4 on the quick twin (500 grains of the calibrated material, its loading
+// density-scaled once the confined grains are at rest): at 4 MPa the sample dilates to its
+// peak and localises in a band inclined to sigma_1, the cement breaking mainly in tension.
+// Measured over seeds 1-5, scaled and unscaled (campaigns/fewer-steps-shear-band-at-rest-2d.toml):
+// tensile against shear breaks 163-523 against 106-215; the band at 22.25-53.25 deg (the
+// scaled mean 36.5, sd 11.3; the paper: about 35), so one seed is held to 15-60 deg, where a
+// compaction band would be beyond 70; its contrast 2.9-5.6. The rise of the shear breaks and
+// the crushing from 4 to 18 MPa on one material is the envelope sweep's
+// (QuickProtocols.EnvelopeSweepGivesMohrCoulombLineAndCap).
 TEST(QuickProtocols, LowConfinementLocalisesInAnInclinedBand) {
   Lab lab("shear-band");
   nb::Notebook n = runQuick(lab, "biaxial-shear-band-quick");
@@ -38,7 +39,7 @@ TEST(QuickProtocols, LowConfinementLocalisesInAnInclinedBand) {
   EXPECT_EQ(result(n, "band_is_compaction"), 0.0);
   EXPECT_GT(result(n, "band_angle_deg"), 15.0);
   EXPECT_LT(result(n, "band_angle_deg"), 60.0);
-  EXPECT_GT(result(n, "band_contrast"), 3.0);  // a band, not diffuse strain
+  EXPECT_GT(result(n, "band_contrast"), 2.5);  // a band, not diffuse strain
 }
 
 // Figure 5 on the compaction band's quick twin (250 grains of the hand-set material; its
