@@ -44,9 +44,10 @@ double lateralStress(const LoadingFrame<D>& f) {
 // come, to show how far the sample is from balance.
 template <int D>
 double interiorDeviatoricStress(const LoadingFrame<D>& f) {
+  const Vec<D> sigma = f.interiorStress();
   double lateral = 0.0;
-  for (int a = 0; a < D - 1; ++a) lateral += f.interiorStress(a);
-  return f.interiorStress(Specimen<D>::kAxial) - lateral / (D - 1);
+  for (int a = 0; a < D - 1; ++a) lateral += sigma[a];
+  return sigma[Specimen<D>::kAxial] - lateral / (D - 1);
 }
 
 // The positions of the particles in slot order (stable through re-sorting), z = 0 in 2D.

@@ -51,12 +51,15 @@ double LoadingFrame<D>::stress(int axis) const {
 }
 
 template <int D>
-double LoadingFrame<D>::interiorStress(int axis) const {
+Vec<D> LoadingFrame<D>::interiorStress() const {
   Vec<D> centre;
   for (int a = 0; a < D; ++a) {
     centre[a] = 0.5 * (sim_->wall(2 * a).point[a] + sim_->wall(2 * a + 1).point[a]);
   }
-  return stress(axis) + sim_->unbalancedForceMoment(centre)[axis] / volume();
+  // One pass over the bodies for every axis: the rig reads all of them at each record.
+  Vec<D> sigma = sim_->unbalancedForceMoment(centre) / volume();
+  for (int a = 0; a < D; ++a) sigma[a] += stress(a);
+  return sigma;
 }
 
 template <int D>

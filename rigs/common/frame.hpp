@@ -99,10 +99,10 @@ class LoadingFrame {
   double faceArea(int axis) const;
   double stress(int axis) const;  // Pa, compression positive, mean of the axis's two walls
   double force(int axis) const;   // N, compression positive, mean of the axis's two walls
-  // Pa, compression positive: the Love-Weber average stress of the box's contents along the
+  // Pa, compression positive: the Love-Weber average stress of the box's contents along each
   // axis, the wall stress less the inertia and damping the walls also carry
   // (Simulation::unbalancedForceMoment). Equal to stress() in equilibrium.
-  double interiorStress(int axis) const;
+  Vec<D> interiorStress() const;
   // Moves the walls of an axis to lo (its lower wall) and hi (its upper), at once: platens
   // brought to touch a specimen cut from the sample, side walls taken away from it. They
   // must press on nothing there (Simulation::placeWall).
