@@ -142,7 +142,8 @@ GALLERY_DIR := build/gallery
 STUDY = $(ROCKLAB) study accuracy --threads 1 --quiet --lab $(GALLERY_DIR)/lab-$@.sqlite \
   --out $(GALLERY_DIR)/$@
 GALLERY := oedometer biaxial envelope hydrostatic permeameter ultrasonic fewer-steps \
-  fewer-steps-slow fewer-steps-shear-band fewer-steps-shear-band-at-rest oedometer-rate-boost \
+  fewer-steps-slow fewer-steps-shear-band fewer-steps-shear-band-at-rest fewer-steps-compaction-band \
+  oedometer-rate-boost \
   formation-end compaction-band-rate-boost \
   shear-band-rate-boost envelope-rate-boost
 .PHONY: $(GALLERY)
@@ -185,7 +186,8 @@ fewer-steps: build
 # the quick count, the loading scaled alone on each seed's formed sample and with its formation
 # (protocols/campaigns/fewer-steps-superparticle-2d.toml, run on the local pool); and the 4 MPa
 # shear band test, its loading scaled 4 times or not (fewer-steps-shear-band-2d.toml), and so
-# again with the confinement held until the grains are at rest (-at-rest-2d.toml).
+# again with the confinement held until the grains are at rest (-at-rest-2d.toml); the 18 MPa
+# compaction band test the same way, held at rest (fewer-steps-compaction-band-2d.toml).
 define campaign_study
 	$(ROCKLAB) campaign run protocols/campaigns/$(1).toml --quiet --lab $(GALLERY_DIR)/lab-$@.sqlite
 	$(ROCKLAB) study report --lab $(GALLERY_DIR)/lab-$@.sqlite --out $(GALLERY_DIR)/$@ \
@@ -200,6 +202,8 @@ fewer-steps-shear-band: build
 	$(call campaign_study,fewer-steps-shear-band-2d)
 fewer-steps-shear-band-at-rest: build
 	$(call campaign_study,fewer-steps-shear-band-at-rest-2d)
+fewer-steps-compaction-band: build
+	$(call campaign_study,fewer-steps-compaction-band-2d)
 # The adaptive rate in the oedometer (off in the protocol: with its cycles at the set rate
 # it saves only 7%).
 oedometer-rate-boost: build
