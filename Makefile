@@ -216,8 +216,9 @@ formation-end: build
 	$(STUDY) protocols/biaxial-ucs-quick.toml --vary formation.densified_porosity_change=0,0.0005 \
 	  --vary formation.local_damping=0.7,0.1 --seeds 5
 	$(gallery_png)
-# The adaptive rate in the 2D band quick twins and the envelope's (on in the compaction band's and
-# the envelope's, on their hand-set material; off in the full protocols and so in the shear band's).
+# The adaptive rate in the 2D band quick twins and the envelope's (on in the envelope's, on its
+# hand-set material; off in the full protocols and so in the band twins, which have been those
+# at 500 grains since: the band twins' images are still of the hand-set twins at 250 grains).
 compaction-band-rate-boost: build
 	$(STUDY) protocols/biaxial-compaction-band-quick.toml --vary loading.rate_boost_max=1,2 \
 	  --seeds 5
