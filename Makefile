@@ -116,11 +116,12 @@ paper: build
 # holds a run to them). Two seeds at a time, each a process on one thread whose notebook is
 # merged into build/references/lab.sqlite (about an hour and a quarter on 2 cores; one
 # protocol's reference in half the time of one core).
-# An explicit step: review `git diff tests/reference` before committing. REFERENCES picks some
-# (make references REFERENCES=protocols/biaxial-ucs-quick.toml).
+# Run again after it was stopped, it keeps the seeds the same build finished (a build of other
+# code runs them all again). An explicit step: review `git diff tests/reference` before
+# committing. REFERENCES picks some (make references REFERENCES=protocols/biaxial-ucs-quick.toml).
 REFERENCES ?= $(wildcard protocols/*-quick.toml)
 references: build
-	@rm -rf build/references && mkdir -p build/references
+	@mkdir -p build/references
 	$(ROCKLAB) regress update $(REFERENCES) --jobs 2 --threads 1 --seeds 8 --out tests/reference \
 	  --lab build/references/lab.sqlite
 

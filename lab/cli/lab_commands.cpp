@@ -211,7 +211,7 @@ rigs::Journal::Options journalOptions(const protocol::Settings& settings) {
   rigs::Journal::Options o;
   o.every_s = settings.real("output.checkpoint_every_s");
   o.protocol_hash = notebook::hashText(settings.identity());
-  o.code_version = kGitRevision;
+  o.code_version = codeVersion();
   return o;
 }
 
@@ -242,7 +242,7 @@ RunOutcome runSettings(const rigs::RigEntry& rig, const protocol::Settings& sett
     info.protocol_text = protocol_text;
     info.protocol_hash = jo.protocol_hash;
     info.rig = std::string(rig.name);
-    info.code_version = kGitRevision;
+    info.code_version = codeVersion();
     info.build_type = kBuildType;
     info.seed = settings.integer("protocol.seed");
     info.threads = static_cast<int>(settings.integer("numerics.threads"));
@@ -374,9 +374,9 @@ int rerunProtocol(std::int64_t run, const RunOptions& o) {
       overrides.insert(overrides.begin(), {in.text(0), "\"" + copy + "\"", "rerun"});
     }
   }
-  if (r.version != kGitRevision) {
+  if (r.version != codeVersion()) {
     std::cerr << "warning: run " << run << " was made by rocklab " << r.version << ", this is "
-              << kGitRevision << ": results may differ where the code changed\n";
+              << codeVersion() << ": results may differ where the code changed\n";
   }
   const auto c = recheck(run, r, overrides, o.threads);
   if (!c) return 2;
@@ -403,9 +403,9 @@ int resumeRun(std::int64_t run, const RunOptions& o) {
     std::cerr << "run " << run << " is still running (pid " << r.pid << " on " << r.host << ")\n";
     return 2;
   }
-  if (r.version != kGitRevision) {
+  if (r.version != codeVersion()) {
     std::cerr << "run " << run << " cannot resume: it was made by rocklab " << r.version
-              << ", this is " << kGitRevision
+              << ", this is " << codeVersion()
               << ": only the same code continues a run bit for bit\n";
     return 2;
   }

@@ -225,6 +225,34 @@ extern "C" void onUpdateSignal(int sig) {
   g_stop.store(sig);
 }
 
+// The completed run at `seed` of these very settings and input files that this very build
+// made, if the lab has one: an update killed or failed part-way and run again keeps the seeds
+// it finished (a reference of eight half-hour runs outlives a session). A run of another build
+// is run again.
+std::optional<reports::RunData> keptRun(notebook::Notebook& lab, protocol::Settings settings,
+                                        std::int64_t seed, const std::string& file) {
+  settings.override("protocol.seed", seed);
+  auto q = lab.db().prepare(
+      "SELECT id FROM runs WHERE protocol_hash = ? AND seed = ? AND status = 'completed' AND "
+      "code_version = ? AND build_type = ? ORDER BY id DESC LIMIT 1");
+  q.bind(1, notebook::hashText(settings.identity())).bind(2, seed);
+  q.bind(3, codeVersion()).bind(4, std::string(kBuildType));
+  if (!q.step()) return std::nullopt;
+  const std::int64_t run = q.integer(0);
+  // A file the run read (a packing, a table) that has changed since makes it another run.
+  auto in = lab.db().prepare("SELECT path, sha256 FROM inputs WHERE run_id = ?");
+  in.bind(1, run);
+  while (in.step()) {
+    const std::string path = in.text(0);
+    if (!std::filesystem::is_regular_file(path) || notebook::fileSha256(path) != in.text(1)) {
+      return std::nullopt;
+    }
+  }
+  std::cout << file << ": seed " << seed << " is run " << run
+            << " of the lab, completed by this build: kept\n";
+  return reports::loadRun(lab, run);
+}
+
 // A protocol run at `seeds` seeds from its own; the runs' data, or fewer when one failed.
 // Here the runs are in this process, one after the other.
 std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const std::string& file,
@@ -232,6 +260,13 @@ std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const s
   const std::int64_t seed0 = c.settings.integer("protocol.seed");
   std::vector<reports::RunData> runs;
   for (int k = 0; k < o.seeds; ++k) {
+    {
+      notebook::Notebook nb(o.lab);
+      if (auto kept = keptRun(nb, c.settings, seed0 + k, file)) {
+        runs.push_back(std::move(*kept));
+        continue;
+      }
+    }
     protocol::Settings s = c.settings;
     s.override("protocol.seed", seed0 + k);
     if (o.threads > 0) s.runChoice("numerics.threads", static_cast<std::int64_t>(o.threads));
@@ -275,6 +310,10 @@ std::vector<reports::RunData> runAtSeedsAtOnce(const rigs::CheckedProtocol& c,
   while (next < o.seeds || !running.empty()) {
     while (g_stop.load() == 0 && !failed && next < o.seeds &&
            static_cast<int>(running.size()) < o.jobs) {
+      if ((done[static_cast<std::size_t>(next)] = keptRun(lab, c.settings, seed0 + next, file))) {
+        ++next;
+        continue;
+      }
       std::vector<std::string> args = {selfExecutable(),
                                        "run",
                                        std::filesystem::absolute(file).string(),
@@ -347,7 +386,7 @@ std::string referenceFile(const rigs::CheckedProtocol& c,
   const std::size_t n = runs.size();
   std::ostringstream file;
   file << "# Key results of " << name << " guarded by the regression test (tests/e2e).\n"
-       << "# Written by `rocklab regress update` at git " << kGitRevision
+       << "# Written by `rocklab regress update` at git " << codeVersion()
        << "; review the diff before committing.\n"
        << "# values: at each seed. A check at m of the seeds holds the mean of its values to "
           "the mean of\n# these within t("

@@ -19,6 +19,7 @@
 #include <iterator>
 #include <memory>
 #include <random>
+#include <regex>
 #include <thread>
 
 #include "lab/core/packing_io.hpp"
@@ -810,7 +811,8 @@ TEST(Protocols, SigtermLeavesAnInterruptedRunWithItsData) {
 
 // `regress update --jobs 2` runs the seeds two at a time, each in a process of its own whose
 // notebook is merged into the lab: the same reference file as one run after the other (every
-// value, bit for bit), the runs in the lab with the shard each came from, no shard left. A
+// value, bit for bit), the runs in the lab with the shard each came from, no shard left. Run
+// again with more seeds, either way, it keeps the runs the lab has and runs the rest. A
 // SIGTERM to the update alone reaches its runs: it ends with 130 and writes no reference, its
 // runs interrupted in the lab with what they recorded.
 TEST(Protocols, RegressUpdateRunsTheSeedsAtOnceToTheSameReference) {
@@ -819,18 +821,20 @@ TEST(Protocols, RegressUpdateRunsTheSeedsAtOnceToTheSameReference) {
       "tiny-ucs", "base = \"" + sourceDir() +
                       "/protocols/biaxial-ucs-hand-set.toml\"\n[protocol]\nname = \"tiny-ucs\"\n"
                       "[sample]\ncount = 60\n");
-  auto update = [&](const Lab& lab, const std::string& jobs) {
-    std::string out;
-    EXPECT_EQ(rocklab::testing::runRocklab("regress update " + protocol +
-                                               " --seeds 2 --threads 1 --out " + lab.path +
-                                               ".ref --lab " + lab.path + jobs,
+  // The reference file an update at `seeds` seeds writes; what it printed in `out`.
+  auto update = [&](const Lab& lab, int seeds, const std::string& jobs, std::string& out) {
+    EXPECT_EQ(rocklab::testing::runRocklab("regress update " + protocol + " --seeds " +
+                                               std::to_string(seeds) + " --threads 1 --out " +
+                                               lab.path + ".ref --lab " + lab.path + jobs,
                                            &out),
               0)
         << out;
     std::ifstream in(lab.path + ".ref/tiny-ucs.toml");
     return std::string((std::istreambuf_iterator<char>(in)), {});
   };
-  const std::string sequential = update(one, ""), at_once = update(two, " --jobs 2");
+  std::string out;
+  const std::string sequential = update(one, 2, "", out);
+  const std::string at_once = update(two, 2, " --jobs 2", out);
   EXPECT_NE(sequential.find("seeds = [1, 2]"), std::string::npos) << sequential;
   EXPECT_EQ(at_once, sequential);
   EXPECT_EQ(rows(two.path, "SELECT seed, status FROM runs ORDER BY seed"),
@@ -840,6 +844,22 @@ TEST(Protocols, RegressUpdateRunsTheSeedsAtOnceToTheSameReference) {
                  "'%.regress/tiny-ucs-seed-_.sqlite'"),
             std::vector<std::string>{"2|"});
   EXPECT_FALSE(std::filesystem::exists(two.path + ".regress"));
+  // Run again with a third seed, both ways: the seeds the lab has from this build are kept,
+  // only the new one runs, to the same file.
+  const std::string three = update(one, 3, "", out);
+  EXPECT_NE(three.find("seeds = [1, 2, 3]"), std::string::npos) << three;
+  for (const Lab* lab : {&one, &two}) {
+    if (lab == &two) EXPECT_EQ(update(two, 3, " --jobs 2", out), three);
+    for (const char* seed : {"1", "2"}) {
+      EXPECT_TRUE(std::regex_search(out, std::regex(std::string("seed ") + seed +
+                                                    " is run [12] of the lab, completed by "
+                                                    "this build: kept")))
+          << out;
+    }
+    EXPECT_EQ(out.find("seed 3 is run"), std::string::npos) << out;
+    EXPECT_EQ(rows(lab->path, "SELECT seed, status FROM runs ORDER BY seed"),
+              (std::vector<std::string>{"1|completed|", "2|completed|", "3|completed|"}));
+  }
 
   const pid_t pid =
       resume::start({"regress", "update", protocol, "--seeds", "2", "--threads", "1", "--jobs", "2",
