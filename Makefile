@@ -112,8 +112,8 @@ paper: build
 	  --out $(PAPER_DIR)/catalogue.md
 
 # The regression references of the quick protocols (tests/reference, checked by the e2e tests):
-# each protocol at eight seeds, their values, mean and scatter (tests/README.md says how a check
-# holds a run to them). Two seeds at a time, each a process on one thread whose notebook is
+# each protocol at as many seeds as its reference has (eight for a new one), their values, mean
+# and scatter (tests/README.md says how a check holds a run to them). Two seeds at a time, each a process on one thread whose notebook is
 # merged into build/references/lab.sqlite (about an hour and a quarter on 2 cores; one
 # protocol's reference in half the time of one core).
 # Run again after it was stopped, it keeps the seeds the same build finished (a build of other
@@ -122,7 +122,7 @@ paper: build
 REFERENCES ?= $(wildcard protocols/*-quick.toml)
 references: build
 	@mkdir -p build/references
-	$(ROCKLAB) regress update $(REFERENCES) --jobs 2 --threads 1 --seeds 8 --out tests/reference \
+	$(ROCKLAB) regress update $(REFERENCES) --jobs 2 --threads 1 --out tests/reference \
 	  --lab build/references/lab.sqlite
 
 # What each bond model reaches (issue 28): the bond-model-reach campaigns (the UCS test, direct

@@ -13,8 +13,9 @@ source tree) when given: a protocol whose defaults moved to new keys runs as it 
 is what a user of the old binary waited for. Printed per protocol: the median wall time
 of each binary (the process's, what a user waits for), their ratio old / new, and each key
 result of the new binary's last run against the seed scatter of the protocol's regression
-reference (tests/reference/<protocol>.toml holds its values at eight seeds): inside when it
-lies in the 95% prediction interval of one more seed, mean +- t(0.975, n - 1) s sqrt(1 + 1/n).
+reference (tests/reference/<protocol>.toml holds its values at eight seeds or more): inside
+when it lies in the 95% prediction interval of one more seed, mean +- t(0.975, n - 1) s
+sqrt(1 + 1/n).
 A result the reference does not guard is listed as such. With --stages PREFIX, also the
 median seconds of each stage timing of the notebook whose name starts with PREFIX (for
 example the permeameter's flow, flow_network and flow_solve), for each binary.
@@ -39,8 +40,10 @@ import tomllib
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(HERE)
 
-# t(0.975, df), df = 1..10 (Abramowitz & Stegun, table 26.10).
-T975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228]
+# t(0.975, df), df = 1..30 (Abramowitz & Stegun, table 26.10); beyond, df = 30's (wider).
+T975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
+        2.201, 2.179, 2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086,
+        2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042]
 
 
 def fresh(path):

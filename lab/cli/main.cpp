@@ -458,7 +458,8 @@ void addRegress(CLI::App& app, Action& action) {
   rgu->add_option("--out", u->out, "Folder of the reference files");
   rgu->add_option("--lab", u->lab, "Lab notebook the runs go to");
   rgu->add_option("--seeds", u->seeds,
-                  "Seeds per protocol, from its own (the check's interval narrows with them)")
+                  "Seeds per protocol, from its own (the check's interval narrows with them; "
+                  "default: as many as its reference in --out has, 8 for a new one)")
       ->check(CLI::Range(2, 100));
   rgu->add_option("--threads", u->threads, "Threads of every run")->check(CLI::Range(1, 1024));
   rgu->add_option("--jobs", u->jobs,

@@ -36,6 +36,9 @@ constexpr double kWidestGuard = 0.15;
 // An interval at least this share of the mean: a result the seeds do not scatter (the stress
 // a servo reached) still moves by a last bit or two.
 constexpr double kNarrowestGuard = 1e-6;
+// The seeds of a new reference: a key result scattering up to 8.6% of its mean is guarded
+// at all of them (t(0.995, 7) s sqrt(1/8 + 1/8) = 1.75 s <= 15%).
+constexpr int kDefaultSeeds = 8;
 
 struct Reference {
   std::string protocol;
@@ -256,10 +259,11 @@ std::optional<reports::RunData> keptRun(notebook::Notebook& lab, protocol::Setti
 // A protocol run at `seeds` seeds from its own; the runs' data, or fewer when one failed.
 // Here the runs are in this process, one after the other.
 std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const std::string& file,
-                                         const RegressUpdateOptions& o, bool& interrupted) {
+                                         int seeds, const RegressUpdateOptions& o,
+                                         bool& interrupted) {
   const std::int64_t seed0 = c.settings.integer("protocol.seed");
   std::vector<reports::RunData> runs;
-  for (int k = 0; k < o.seeds; ++k) {
+  for (int k = 0; k < seeds; ++k) {
     {
       notebook::Notebook nb(o.lab);
       if (auto kept = keptRun(nb, c.settings, seed0 + k, file)) {
@@ -291,7 +295,7 @@ std::vector<reports::RunData> runAtSeeds(const rigs::CheckedProtocol& c, const s
 // A signal stops starting runs and reaches the running ones, which end interrupted, their
 // data merged all the same.
 std::vector<reports::RunData> runAtSeedsAtOnce(const rigs::CheckedProtocol& c,
-                                               const std::string& file,
+                                               const std::string& file, int seeds,
                                                const RegressUpdateOptions& o, bool& interrupted) {
   const std::int64_t seed0 = c.settings.integer("protocol.seed");
   const std::string dir = std::filesystem::absolute(o.lab).string() + ".regress";
@@ -300,15 +304,15 @@ std::vector<reports::RunData> runAtSeedsAtOnce(const rigs::CheckedProtocol& c,
     return dir + "/" + c.settings.text("protocol.name") + "-seed-" + std::to_string(seed0 + k);
   };
   notebook::Notebook lab(o.lab);
-  std::vector<std::optional<reports::RunData>> done(static_cast<std::size_t>(o.seeds));
+  std::vector<std::optional<reports::RunData>> done(static_cast<std::size_t>(seeds));
   std::map<pid_t, int> running;
   bool failed = false;
   int next = 0, forwarded = 0;
   g_stop.store(0);
   std::signal(SIGINT, onUpdateSignal);
   std::signal(SIGTERM, onUpdateSignal);
-  while (next < o.seeds || !running.empty()) {
-    while (g_stop.load() == 0 && !failed && next < o.seeds &&
+  while (next < seeds || !running.empty()) {
+    while (g_stop.load() == 0 && !failed && next < seeds &&
            static_cast<int>(running.size()) < o.jobs) {
       if ((done[static_cast<std::size_t>(next)] = keptRun(lab, c.settings, seed0 + next, file))) {
         ++next;
@@ -430,10 +434,24 @@ std::string referenceFile(const rigs::CheckedProtocol& c,
   return file.str();
 }
 
+// The seeds to write a reference at: --seeds, else as many as the reference being replaced
+// has (a result guarded only at more than 8 stays guarded), else kDefaultSeeds.
+int seedsOf(const RegressUpdateOptions& o, const std::string& reference) {
+  if (o.seeds > 0) return o.seeds;
+  if (!std::filesystem::exists(reference)) return kDefaultSeeds;
+  try {
+    return static_cast<int>(readReference(reference).seeds.size());
+  } catch (const std::exception& e) {  // an older format: written anew at the default
+    std::cerr << e.what() << "\n"
+              << reference << ": written anew at " << kDefaultSeeds << " seeds\n";
+    return kDefaultSeeds;
+  }
+}
+
 }  // namespace
 
 int regressUpdate(const RegressUpdateOptions& o) {
-  if (o.seeds < 2) {
+  if (o.seeds != 0 && o.seeds < 2) {
     std::cerr << "regress update: --seeds must be at least 2 (the interval is their scatter)\n";
     return 2;
   }
@@ -454,14 +472,16 @@ int regressUpdate(const RegressUpdateOptions& o) {
   bool failed = false;
   for (std::size_t p = 0; p < checked.size(); ++p) {
     bool interrupted = false;
-    const auto runs = o.jobs > 1 ? runAtSeedsAtOnce(checked[p], o.protocols[p], o, interrupted)
-                                 : runAtSeeds(checked[p], o.protocols[p], o, interrupted);
+    const std::string path = o.out + "/" + checked[p].settings.text("protocol.name") + ".toml";
+    const int seeds = seedsOf(o, path);
+    const auto runs = o.jobs > 1
+                          ? runAtSeedsAtOnce(checked[p], o.protocols[p], seeds, o, interrupted)
+                          : runAtSeeds(checked[p], o.protocols[p], seeds, o, interrupted);
     if (interrupted) return 130;
-    if (runs.size() < static_cast<std::size_t>(o.seeds)) {
+    if (runs.size() < static_cast<std::size_t>(seeds)) {
       failed = true;
       continue;
     }
-    const std::string path = o.out + "/" + checked[p].settings.text("protocol.name") + ".toml";
     const std::string temporary = path + ".tmp";
     std::ofstream out(temporary);
     out << referenceFile(checked[p], runs);

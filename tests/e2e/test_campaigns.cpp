@@ -111,7 +111,7 @@ TEST(Campaigns, EveryPointAndSeedRunsOnceIntoTheLabWithItsStatistics) {
   // the statistics hold them.
   std::ifstream sweep_in(report + "/sweep.csv");
   const std::string sweep(std::istreambuf_iterator<char>(sweep_in), {});
-  for (const std::string& friction : {"0.3", "0.5"}) {
+  for (const std::string friction : {"0.3", "0.5"}) {
     const auto stat = rows(lab.path,
                            "SELECT mean, ci95_low, ci95_high FROM campaign_statistics s JOIN "
                            "campaign_points p ON p.campaign_id = s.campaign_id AND p.point = "

@@ -821,13 +821,15 @@ TEST(Protocols, RegressUpdateRunsTheSeedsAtOnceToTheSameReference) {
       "tiny-ucs", "base = \"" + sourceDir() +
                       "/protocols/biaxial-ucs-hand-set.toml\"\n[protocol]\nname = \"tiny-ucs\"\n"
                       "[sample]\ncount = 60\n");
-  // The reference file an update at `seeds` seeds writes; what it printed in `out`.
+  // The reference file an update at `seeds` seeds (0: no --seeds) writes; what it printed in
+  // `out`.
   auto update = [&](const Lab& lab, int seeds, const std::string& jobs, std::string& out) {
-    EXPECT_EQ(rocklab::testing::runRocklab("regress update " + protocol + " --seeds " +
-                                               std::to_string(seeds) + " --threads 1 --out " +
-                                               lab.path + ".ref --lab " + lab.path + jobs,
-                                           &out),
-              0)
+    const std::string count = seeds > 0 ? " --seeds " + std::to_string(seeds) : "";
+    EXPECT_EQ(
+        rocklab::testing::runRocklab("regress update " + protocol + count + " --threads 1 --out " +
+                                         lab.path + ".ref --lab " + lab.path + jobs,
+                                     &out),
+        0)
         << out;
     std::ifstream in(lab.path + ".ref/tiny-ucs.toml");
     return std::string((std::istreambuf_iterator<char>(in)), {});
@@ -849,7 +851,9 @@ TEST(Protocols, RegressUpdateRunsTheSeedsAtOnceToTheSameReference) {
   const std::string three = update(one, 3, "", out);
   EXPECT_NE(three.find("seeds = [1, 2, 3]"), std::string::npos) << three;
   for (const Lab* lab : {&one, &two}) {
-    if (lab == &two) EXPECT_EQ(update(two, 3, " --jobs 2", out), three);
+    if (lab == &two) {
+      EXPECT_EQ(update(two, 3, " --jobs 2", out), three);
+    }
     for (const char* seed : {"1", "2"}) {
       EXPECT_TRUE(std::regex_search(out, std::regex(std::string("seed ") + seed +
                                                     " is run [12] of the lab, completed by "
@@ -860,6 +864,11 @@ TEST(Protocols, RegressUpdateRunsTheSeedsAtOnceToTheSameReference) {
     EXPECT_EQ(rows(lab->path, "SELECT seed, status FROM runs ORDER BY seed"),
               (std::vector<std::string>{"1|completed|", "2|completed|", "3|completed|"}));
   }
+  // Written again without --seeds, a reference keeps its count of seeds (here every one kept).
+  EXPECT_EQ(update(one, 0, "", out), three);
+  EXPECT_NE(out.find("seed 3 is run 3 of the lab, completed by this build: kept"),
+            std::string::npos)
+      << out;
 
   const pid_t pid =
       resume::start({"regress", "update", protocol, "--seeds", "2", "--threads", "1", "--jobs", "2",
