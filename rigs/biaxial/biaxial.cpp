@@ -19,6 +19,15 @@ void LoadingTest::validate() const {
   }
 }
 
+bool LoadingTest::ends(double strain, double load, double volumetric, double peak,
+                       double peak_strain, double peak_volumetric) const {
+  if (strain >= axial_strain_max) return true;
+  const bool dropped = stop_after_drop > 0.0 && peak > 0.0 &&
+                       load < (1.0 - stop_after_drop) * peak && strain > peak_strain &&
+                       strain >= stop_after_drop_min_strain;
+  return dropped && (!stop_after_drop_dilating || volumetric < peak_volumetric);
+}
+
 namespace {
 
 // The names one test records under: its prefix (a test of a sweep: "test2."), its stages,
@@ -158,10 +167,7 @@ LoadingHistory loadAxially(Specimen<D>& sp, const LoadingTest& test, double sigm
       h.peak_volumetric = frame.volumetricStrain();
       h.peak_axial = frame.stress(ax);
     }
-    done =
-        strain >= strain_max ||
-        (test.stop_after_drop > 0.0 && h.peak > 0.0 && q < (1.0 - test.stop_after_drop) * h.peak &&
-         strain > h.peak_strain && strain >= test.stop_after_drop_min_strain);
+    done = test.ends(strain, q, frame.volumetricStrain(), h.peak, h.peak_strain, h.peak_volumetric);
     const double rate_now = rate * h.rate.factor();
     if (steps % record_every == 0 || done) {
       recordState(sp, rec, n.prefix, n.stage, rate_now);

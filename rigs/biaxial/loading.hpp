@@ -21,6 +21,7 @@ struct LoadingTest {
   double axial_strain_max = 0.05;
   double stop_after_drop = 0.0;
   double stop_after_drop_min_strain = 0.002;
+  bool stop_after_drop_dilating = false;
   double rest_speed_ratio = 0.0;
   RateBoost boost;  // rigs/common/adaptive_rate.hpp
 
@@ -39,10 +40,22 @@ struct LoadingTest {
     f(axial_strain_max, loading_keys::kAxialStrainMax);
     f(stop_after_drop, loading_keys::kStopAfterDrop);
     f(stop_after_drop_min_strain, loading_keys::kStopAfterDropMinStrain);
+    f(stop_after_drop_dilating,
+      {"stop_after_drop_dilating",
+       units::text,
+       {},
+       "the drop stops the test only if the sample has dilated since its peak (volumetric "
+       "strain below the peak's): a compacting sample's load falls at a burst of crushing and "
+       "hardens again, where a dilatant failure does not recover"});
     boost.fields(f);
   }
   // A test that stops after the peak must get past it: a drop needs room to show.
   void validate() const;
+  // Whether the test ends at this state: at the strain limit, or past its peak (`peak` the
+  // highest load so far, at `peak_strain` and volumetric strain `peak_volumetric`) once the
+  // load has fallen by stop_after_drop. Volumetric strains compaction positive.
+  bool ends(double strain, double load, double volumetric, double peak, double peak_strain,
+            double peak_volumetric) const;
 };
 
 // The localisation analysis (`analysis.*`, rigs/common/localisation.hpp).

@@ -1,10 +1,12 @@
 // The failure envelope's pieces on synthetic curves with known answers: the critical point
-// of a dilatant and of a compactive test, and the Mohr-Coulomb fit (Li & Holt, equation 1).
+// of a dilatant and of a compactive test, the Mohr-Coulomb fit (Li & Holt, equation 1), and
+// when a test stops after its peak.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "rigs/biaxial/loading.hpp"
 #include "rigs/common/envelope.hpp"
 
 using namespace rocklab::rigs;
@@ -85,4 +87,28 @@ TEST(MohrCoulomb, NeedsTwoDilatantConfinements) {
   EXPECT_FALSE(fitMohrCoulomb({{0.0, 10e6, false}, {18e6, 30e6, true}}).fitted);
   // sigma_1 falling with sigma_3 is no friction angle
   EXPECT_FALSE(fitMohrCoulomb({{0.0, 10e6, false}, {4e6, 9e6, false}}).fitted);
+}
+
+// The drop stop of a test (loading.stop_after_drop): a dilatant failure whose load has fallen
+// 30% below its peak ends the test; a compacting sample's drop at a burst of crushing ends it
+// only where the key that tells the two apart is off.
+TEST(DropStop, EndsADilatantFailureAndLetsACompactingSampleHarden) {
+  rocklab::rigs::biaxial::LoadingTest test;
+  test.axial_strain_max = 0.025;
+  test.stop_after_drop = 0.3;
+  const double peak = 20e6, peak_strain = 0.004, peak_volumetric = 0.006;
+  // Past the peak, 35% below it: dilated since (0.004 < 0.006) or compacted further (0.009).
+  const double strain = 0.006, load = 13e6, dilated = 0.004, compacted = 0.009;
+  EXPECT_TRUE(test.ends(strain, load, dilated, peak, peak_strain, peak_volumetric));
+  EXPECT_TRUE(test.ends(strain, load, compacted, peak, peak_strain, peak_volumetric));
+  test.stop_after_drop_dilating = true;
+  EXPECT_TRUE(test.ends(strain, load, dilated, peak, peak_strain, peak_volumetric));
+  EXPECT_FALSE(test.ends(strain, load, compacted, peak, peak_strain, peak_volumetric));
+  // Not yet 30% below the peak, or before stop_after_drop_min_strain: the test goes on; at
+  // the strain limit it ends whatever the load.
+  EXPECT_FALSE(test.ends(strain, 15e6, dilated, peak, peak_strain, peak_volumetric));
+  EXPECT_FALSE(test.ends(0.0019, load, dilated, peak, 0.0015, peak_volumetric));
+  EXPECT_TRUE(test.ends(0.025, 25e6, compacted, peak, peak_strain, peak_volumetric));
+  test.stop_after_drop = 0.0;
+  EXPECT_FALSE(test.ends(strain, 1e6, dilated, peak, peak_strain, peak_volumetric));
 }
