@@ -114,8 +114,9 @@ paper: build
 # The regression references of the quick protocols (tests/reference, checked by the e2e tests):
 # each protocol at as many seeds as its reference has (eight for a new one), their values, mean
 # and scatter (tests/README.md says how a check holds a run to them). Two seeds at a time, each a process on one thread whose notebook is
-# merged into build/references/lab.sqlite (about an hour and a quarter on 2 cores; one
-# protocol's reference in half the time of one core).
+# merged into build/references/lab.sqlite (about three hours on 2 cores, of which the envelope's
+# 8 seeds take 1 h 20 min and the compaction band's 55 min; one protocol's reference in half the
+# time of one core).
 # Run again after it was stopped, it keeps the seeds the same build finished (a build of other
 # code runs them all again). An explicit step: review `git diff tests/reference` before
 # committing. REFERENCES picks some (make references REFERENCES=protocols/biaxial-ucs-quick.toml).
@@ -164,7 +165,7 @@ biaxial: build
 	$(gallery_png)
 envelope: build
 	$(STUDY) protocols/triaxial-envelope-quick.toml \
-	  --vary loading.axial_strain_rate_per_s=5,10,20
+	  --vary loading.axial_strain_rate_per_s=0.15625,0.3125,0.625
 	$(gallery_png)
 hydrostatic: build
 	$(STUDY) protocols/hydrostatic-quick.toml --vary sample.count=4000,2000,1000,500
@@ -217,9 +218,9 @@ formation-end: build
 	$(STUDY) protocols/biaxial-ucs-quick.toml --vary formation.densified_porosity_change=0,0.0005 \
 	  --vary formation.local_damping=0.7,0.1 --seeds 5
 	$(gallery_png)
-# The adaptive rate in the 2D band quick twins and the envelope's (on in the envelope's, on its
-# hand-set material; off in the full protocols and so in the band twins, which have been those
-# at 500 grains since: the band twins' images are still of the hand-set twins at 250 grains).
+# The adaptive rate in the 2D band quick twins and the envelope's: off in the full protocols and
+# so in their twins, which have been those at 500 grains since; these images are still of the
+# hand-set twins at 250 grains, where it was on in the envelope's.
 compaction-band-rate-boost: build
 	$(STUDY) protocols/biaxial-compaction-band-quick.toml --vary loading.rate_boost_max=1,2 \
 	  --seeds 5

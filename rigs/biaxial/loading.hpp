@@ -45,8 +45,9 @@ struct LoadingTest {
        units::text,
        {},
        "the drop stops the test only if the sample has dilated since its peak (volumetric "
-       "strain below the peak's): a compacting sample's load falls at a burst of crushing and "
-       "hardens again, where a dilatant failure does not recover"});
+       "strain 0.001 below the peak's, more than the elastic swelling of the drop): a "
+       "compacting sample's load falls at a burst of crushing and hardens again, where a "
+       "dilatant failure does not recover"});
     boost.fields(f);
   }
   // A test that stops after the peak must get past it: a drop needs room to show.

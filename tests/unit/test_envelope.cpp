@@ -97,13 +97,15 @@ TEST(DropStop, EndsADilatantFailureAndLetsACompactingSampleHarden) {
   test.axial_strain_max = 0.025;
   test.stop_after_drop = 0.3;
   const double peak = 20e6, peak_strain = 0.004, peak_volumetric = 0.006;
-  // Past the peak, 35% below it: dilated since (0.004 < 0.006) or compacted further (0.009).
-  const double strain = 0.006, load = 13e6, dilated = 0.004, compacted = 0.009;
+  // Past the peak, 35% below it: dilated since (0.004 < 0.006), compacted further (0.009), or
+  // swollen by the elastic unloading of the drop alone (0.0056).
+  const double strain = 0.006, load = 13e6, dilated = 0.004, compacted = 0.009, swollen = 0.0056;
   EXPECT_TRUE(test.ends(strain, load, dilated, peak, peak_strain, peak_volumetric));
   EXPECT_TRUE(test.ends(strain, load, compacted, peak, peak_strain, peak_volumetric));
   test.stop_after_drop_dilating = true;
   EXPECT_TRUE(test.ends(strain, load, dilated, peak, peak_strain, peak_volumetric));
   EXPECT_FALSE(test.ends(strain, load, compacted, peak, peak_strain, peak_volumetric));
+  EXPECT_FALSE(test.ends(strain, load, swollen, peak, peak_strain, peak_volumetric));
   // Not yet 30% below the peak, or before stop_after_drop_min_strain: the test goes on; at
   // the strain limit it ends whatever the load.
   EXPECT_FALSE(test.ends(strain, 15e6, dilated, peak, peak_strain, peak_volumetric));
