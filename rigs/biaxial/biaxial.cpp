@@ -22,7 +22,7 @@ void LoadingTest::validate() const {
 // The volumetric strain a sample must have lost since its peak to count as dilating at a
 // drop. Its load falling 30% unloads it elastically: at a burst of crushing at 18 MPa (500
 // grains, seed 5 of triaxial-envelope-quick) the compacting sample swelled by 0.0004 as q fell;
-// the dilatant tests of that sweep (0-4 MPa, seeds 1-6) had lost 0.0013 to 0.017 at their drop.
+// the dilatant tests of that sweep (0-4 MPa, seeds 1-8) had lost 0.0013 to 0.017 at their drop.
 constexpr double kDilationAtDrop = 1e-3;
 
 bool LoadingTest::ends(double strain, double load, double volumetric, double peak,
