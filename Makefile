@@ -113,10 +113,10 @@ paper: build
 
 # The regression references of the quick protocols (tests/reference, checked by the e2e tests):
 # each protocol at as many seeds as its reference has (eight for a new one), their values, mean
-# and scatter (tests/README.md says how a check holds a run to them). Two seeds at a time, each a process on one thread whose notebook is
-# merged into build/references/lab.sqlite (about three hours on 2 cores, of which the envelope's
-# 8 seeds take 1 h 20 min and the compaction band's 55 min; one protocol's reference in half the
-# time of one core).
+# and scatter (tests/README.md says how a check holds a run to them). Two seeds at a time,
+# each a process on one thread whose notebook is merged into build/references/lab.sqlite (about
+# three hours on 2 cores, of which the envelope's 8 seeds take 1 h 20 min and the compaction
+# band's 55 min; one protocol's reference in half the time of one core).
 # Run again after it was stopped, it keeps the seeds the same build finished (a build of other
 # code runs them all again). An explicit step: review `git diff tests/reference` before
 # committing. REFERENCES picks some (make references REFERENCES=protocols/biaxial-ucs-quick.toml).
