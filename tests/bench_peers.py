@@ -4,7 +4,8 @@
 Not part of `make test`: timings are not assertions. Runs rocklab and LIGGGHTS alternately
 on the same packing, on one core and on two, at least three times each, and prints the
 medians and their ratios (issue 27's targets: rocklab >= 2.5x LIGGGHTS on one core on the
-10k and 50k packings, rocklab on two threads >= 1.85x its own one-core figure), and the
+10k and 50k packings, rocklab on two threads >= 1.85x its own one-core figure), the machine's
+own ceiling for that figure (two one-thread runs at once against one alone: "2 runs/1"), and the
 bonded variant of the scene against the unbonded one on one core (the bonded runs alternate
 with the others, and the bonded scene's hash is checked once with the bonds one at a time,
 `--scalar-bonds`).
@@ -81,6 +82,22 @@ def rocklab_rate(rocklab, packing, threads, steps, extra=()):
     return run["particle_steps_per_second"], run["state_hash"]
 
 
+def rocklab_pair_rate(rocklab, packing, steps):
+    """Two one-thread runs at once, their rates summed: what two cores of this machine give
+    to two independent copies of the work (shared cache, memory bandwidth, the hypervisor's
+    placement of the virtual cores), the most a second thread can add to one run."""
+    cmd = [rocklab, "bench", "--packing", packing, "--threads", "1", "--steps", str(steps),
+           "--json"]
+    runs = [subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    total = 0.0
+    for p in runs:
+        out, _ = p.communicate()
+        if p.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode})")
+        total += json.loads(out)["runs"][0]["particle_steps_per_second"]
+    return total
+
+
 def liggghts_rate(lig_dir, procs, steps):
     cmd = ["liggghts", "-in", os.path.join(PEERS, "liggghts", "in.bench"), "-var", "dir", lig_dir,
            "-var", "steps", str(steps), "-var", "warm", "100", "-var", "skin", "0.0002",
@@ -117,7 +134,8 @@ def main():
             subprocess.run([sys.executable,
                             os.path.join(PEERS, "liggghts", "make_liggghts_input.py"), packing,
                             lig_dir], check=True, capture_output=True)
-            r1, r2, l1, l2, rb, y1, hashes, bonded_hashes = [], [], [], [], [], [], set(), set()
+            r1, r2, rp, l1, l2, rb, y1 = [], [], [], [], [], [], []
+            hashes, bonded_hashes = set(), set()
             for k in range(a.runs):
                 # Alternate the codes so a slow spell of the machine hits both.
                 l1.append(liggghts_rate(lig_dir, 1, a.steps))
@@ -128,6 +146,7 @@ def main():
                 rate, h = rocklab_rate(a.rocklab, packing, 2, a.steps)
                 r2.append(rate)
                 hashes.add(h)
+                rp.append(rocklab_pair_rate(a.rocklab, packing, a.steps))
                 rate, h = rocklab_rate(a.rocklab, packing, 1, a.steps, ["--bonded"])
                 rb.append(rate)
                 bonded_hashes.add(h)
@@ -135,21 +154,24 @@ def main():
                     y1.append(yade_rate(packing, 1, a.steps))
                 print(f"{os.path.basename(packing)} run {k + 1}: LIGGGHTS {l1[-1]:.3e} / "
                       f"{l2[-1]:.3e}, rocklab {r1[-1]:.3e} / {r2[-1]:.3e} (1 / 2 cores), "
+                      f"two 1-thread runs at once {rp[-1]:.3e}, "
                       f"bonded {rb[-1]:.3e} (1 core)", file=sys.stderr)
             bonded_hashes.add(rocklab_rate(a.rocklab, packing, 1, a.steps,
                                            ["--bonded", "--scalar-bonds"])[1])
             med = {n: statistics.median(v) for n, v in
-                   (("l1", l1), ("l2", l2), ("r1", r1), ("r2", r2), ("rb", rb), ("y1", y1)) if v}
+                   (("l1", l1), ("l2", l2), ("r1", r1), ("r2", r2), ("rp", rp), ("rb", rb),
+                    ("y1", y1)) if v}
             same = len(hashes) == 1 and len(bonded_hashes) == 1
             rows.append((os.path.basename(packing), med, same))
     print(f"medians of {a.runs} alternating runs, particle-steps/s ({a.steps} timed steps)")
     print(f"{'packing':<18}{'LIGGGHTS 1':>12}{'rocklab 1':>12}{'ratio':>7}"
-          f"{'LIGGGHTS 2':>12}{'rocklab 2':>12}{'ratio':>7}{'rocklab 2/1':>13}"
+          f"{'LIGGGHTS 2':>12}{'rocklab 2':>12}{'ratio':>7}{'rocklab 2/1':>13}{'2 runs/1':>10}"
           f"{'bonded 1':>12}{'bonded/1':>10}  same hash")
     for name, m, same in rows:
         print(f"{name:<18}{m['l1']:>12.3e}{m['r1']:>12.3e}{m['r1'] / m['l1']:>7.2f}"
               f"{m['l2']:>12.3e}{m['r2']:>12.3e}{m['r2'] / m['l2']:>7.2f}"
-              f"{m['r2'] / m['r1']:>13.2f}{m['rb']:>12.3e}{m['rb'] / m['r1']:>10.2f}"
+              f"{m['r2'] / m['r1']:>13.2f}{m['rp'] / m['r1']:>10.2f}"
+              f"{m['rb']:>12.3e}{m['rb'] / m['r1']:>10.2f}"
               f"  {'yes' if same else 'NO'}"
               + (f"   Yade 1 core {m['y1']:.3e}, rocklab / Yade {m['r1'] / m['y1']:.1f}"
                  if "y1" in m else ""))

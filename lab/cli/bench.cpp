@@ -235,9 +235,18 @@ BenchResult runBench(const Packing<3>& packing, const BenchOptions& options, int
   r.coordination_start = sim.coordinationNumber();
   r.wall_stress_start = meanWallStress(sim);
   const std::uint64_t rebuilds = sim.contacts().rebuilds;
+  const std::vector<StageTiming> before = sim.stageTimings();
   const auto t0 = std::chrono::steady_clock::now();
   sim.run(options.steps);
   const auto t1 = std::chrono::steady_clock::now();
+  r.stages = sim.stageTimings();
+  for (StageTiming& s : r.stages) {
+    for (const StageTiming& b : before) {
+      if (b.name != s.name) continue;
+      s.seconds -= b.seconds;
+      s.calls -= b.calls;
+    }
+  }
   r.seconds = std::chrono::duration<double>(t1 - t0).count();
   r.particle_steps_per_second =
       static_cast<double>(r.particles) * static_cast<double>(r.steps) / r.seconds;
@@ -358,8 +367,12 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
           << ", \"listed_pairs\": " << r.listed_pairs << ", \"bonds\": " << r.bonds
           << ", \"bond_lane_width\": " << r.bond_lane_width
           << ", \"flat_joints\": " << (r.flat_joints ? "true" : "false")
-          << ", \"peak_rss_bytes\": " << r.peak_rss_bytes << ", \"state_hash\": \"" << std::hex
-          << r.state_hash << std::dec << "\"}" << (k + 1 < results.size() ? "," : "") << "\n";
+          << ", \"peak_rss_bytes\": " << r.peak_rss_bytes << ", \"stage_seconds\": {";
+      for (std::size_t s = 0; s < r.stages.size(); ++s) {
+        out << (s ? ", " : "") << "\"" << r.stages[s].name << "\": " << r.stages[s].seconds;
+      }
+      out << "}, \"state_hash\": \"" << std::hex << r.state_hash << std::dec << "\"}"
+          << (k + 1 < results.size() ? "," : "") << "\n";
     }
     out << "  ]";
     auto call = [&](const FlowCall& c) {
@@ -420,6 +433,16 @@ void printBench(std::ostream& out, const std::vector<BenchResult>& results,
         << std::fixed << std::setprecision(3) << std::setw(9) << r.coordination_start
         << std::setw(7) << r.coordination_end << std::setw(20) << stress.str() << std::setw(10)
         << r.rebuilds << std::setw(13) << rss.str() << std::hex << r.state_hash << std::dec << "\n";
+  }
+  for (const BenchResult& r : results) {
+    // The stages' wall time (what the steps spend outside them: the rebuild test, the loop).
+    out << "  " << r.threads << (r.threads == 1 ? " thread" : " threads") << ", seconds per stage:";
+    double staged = 0.0;
+    for (const StageTiming& s : r.stages) {
+      out << " " << s.name << " " << std::setprecision(3) << s.seconds;
+      staged += s.seconds;
+    }
+    out << ", outside them " << r.seconds - staged << "\n";
   }
   auto call = [&](const char* name, const FlowCall& c) {
     out << "  " << name << ": network " << c.network_seconds << " s, solve " << c.solve_seconds

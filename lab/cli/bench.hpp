@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lab/core/packing.hpp"
+#include "lab/core/stage_clock.hpp"
 
 namespace rocklab {
 
@@ -51,6 +52,9 @@ struct BenchResult {
   bool flat_joints = false;        // the bonds were flat joints (one at a time, beside the lanes)
   std::uint64_t state_hash = 0;
   double peak_rss_bytes = 0.0;  // of the process so far (getrusage)
+  // Wall time of each stage of the step in the timed phase (those the scene calls): where a
+  // second thread's time goes, stage by stage.
+  std::vector<StageTiming> stages;
 };
 
 // One call of the pore network: measured (and triangulated on the first call), then solved.

@@ -165,12 +165,6 @@ struct ClumpBreak {
   }
 };
 
-struct StageTiming {
-  std::string name;
-  double seconds = 0.0;
-  std::uint64_t calls = 0;
-};
-
 template <int D>
 class Simulation {
  public:

@@ -4,10 +4,18 @@
 
 #include <chrono>
 #include <cstdint>
+#include <string>
 
 namespace rocklab {
 
 struct StageTime {
+  double seconds = 0.0;
+  std::uint64_t calls = 0;
+};
+
+// A stage's clock as the simulation reports it.
+struct StageTiming {
+  std::string name;
   double seconds = 0.0;
   std::uint64_t calls = 0;
 };

@@ -64,6 +64,25 @@ TEST(Cli, BenchGivesTheSameStateOnOneAndTwoThreads) {
   ASSERT_EQ(hashes.size(), 2u) << r.out;
   EXPECT_EQ(hashes[0], hashes[1]);
   EXPECT_NE(r.out.find("\"particle_steps_per_second\""), std::string::npos);
+  // Each run's stages are timed over its timed steps alone: the contact pass took time, and
+  // the stages together took no more than the run (the warm-up's time is not theirs).
+  std::regex run_line("\"seconds\": ([0-9.e+-]+),.*\"stage_seconds\": \\{([^}]*)\\}");
+  std::regex stage("\"([a-z_]+)\": ([0-9.e+-]+)");
+  int timed = 0;
+  for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), run_line);
+       it != std::sregex_iterator(); ++it, ++timed) {
+    const std::string stages = (*it)[2];
+    double sum = 0.0;
+    bool contacts = false;
+    for (auto s = std::sregex_iterator(stages.begin(), stages.end(), stage);
+         s != std::sregex_iterator(); ++s) {
+      sum += std::stod((*s)[2]);
+      contacts |= (*s)[1] == "contacts" && std::stod((*s)[2]) > 0.0;
+    }
+    EXPECT_TRUE(contacts) << stages;
+    EXPECT_LE(sum, std::stod((*it)[1])) << stages;
+  }
+  EXPECT_EQ(timed, 2) << r.out;
   // The saved packing runs again from the file and gives the same state.
   const auto again = run("bench --packing " + packing + " --steps 60 --warmup 10 --json");
   ASSERT_EQ(again.status, 0) << again.out;
