@@ -66,10 +66,15 @@ struct PairBuffers {
   std::vector<std::vector<std::uint32_t>> own_cross_row;
   std::vector<std::uint32_t> cross, cross_row;  // all cross pairs (ascending) and their rows
   std::vector<std::size_t> cross_start;         // where each thread's cross pairs start in `cross`
+  std::vector<std::uint32_t> cross_index;       // a cross pair's place in `cross`, by pair
   std::vector<KeptContact<D>> cross_result, wall_result;
   std::vector<std::size_t> wall_split;
   std::vector<double> block_friction, block_viscous, block_cost;
   std::vector<std::uint32_t> block_touching;  // touching pairs per block, last threaded step
+  // Each thread's pace in its rows (split cost per second), smoothed over the steps, and the
+  // cost and seconds of its rows in the last step: the split follows the pace of the core
+  // each thread ran on (threadedPairLoop).
+  std::vector<double> thread_pace, thread_cost, thread_seconds;
   std::vector<std::uint8_t> block_over, thread_over;
 };
 
@@ -80,6 +85,10 @@ class ContactModel {
   virtual std::string_view law() const = 0;
   // Pair and wall forces of one step, added to the particles' forces and torques.
   virtual void computeForces(ContactPass<D>& pass) = 0;
+  // The rows each thread took in the last threaded pass, [rows[t], rows[t + 1]) (whole
+  // blocks of kBlockRows but the last run's end); empty before one. The per-particle passes
+  // take the same runs, so a particle stays on the core that computed its forces.
+  virtual const std::vector<std::size_t>& threadRows() const = 0;
   // Tangent normal and shear stiffness (N/m) of a contact at an overlap.
   virtual std::pair<double, double> stiffness(std::uint16_t mi, std::uint16_t mj, double overlap,
                                               const ContactShape& g, double mstar) const = 0;

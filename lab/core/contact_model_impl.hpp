@@ -29,6 +29,7 @@ class ContactModelImpl final : public ContactModel<D> {
       : name_(name), table_(std::move(table)), materials_(std::move(materials)) {}
 
   std::string_view law() const override { return name_; }
+  const std::vector<std::size_t>& threadRows() const override { return buffers_.range; }
 
   void computeForces(ContactPass<D>& pass) override {
     if (pass.threaded) {
@@ -332,10 +333,13 @@ class ContactModelImpl final : public ContactModel<D> {
     addBlockSums(pass, blocks);
   }
 
-  // Runs of whole blocks, one per thread, of about the same cost: a touching pair costs
-  // some 25 times a pair out of reach, so the split follows the blocks' touching pairs of the
-  // last step (the pair count when there is none). Where the runs meet changes nothing in
-  // the results, only who computes what.
+  // Runs of whole blocks, one per thread, each of the cost its thread's pace gets through in
+  // the same time. A touching pair costs some 25 times a pair out of reach, so a block's cost
+  // is its touching pairs of the last step (its pair count when there is none). The paces are
+  // measured: on a shared machine one core runs slower than the other for seconds at a time
+  // (on the 2-core virtual machine of the benchmarks, either of them by up to 40%), and an
+  // even split left the faster thread waiting at the end of every pass. Where the runs meet
+  // changes nothing in the results, only who computes what.
   void splitRows(std::size_t n, std::size_t blocks, int threads, const std::uint32_t* row) {
     auto& B = buffers_;
     std::vector<double>& cost = B.block_cost;
@@ -345,13 +349,40 @@ class ContactModelImpl final : public ContactModel<D> {
       const double pairs = row[std::min(n, (b + 1) * kBlockRows)] - row[b * kBlockRows];
       cost[b + 1] = cost[b] + 0.04 * pairs + B.block_touching[b];
     }
+    // Unmeasured (the first threaded step, or a new thread count): even shares.
+    if (B.thread_pace.size() != static_cast<std::size_t>(threads)) {
+      B.thread_pace.assign(threads, 0.0);
+    }
+    const bool measured = std::ranges::all_of(B.thread_pace, [](double p) { return p > 0.0; });
+    const auto paceOf = [&](int t) { return measured ? B.thread_pace[t] : 1.0; };
+    double pace = 0.0;
+    for (int t = 0; t < threads; ++t) pace += paceOf(t);
     B.range.assign(threads + 1, n);
     B.range[0] = 0;
     std::size_t b = 0;
+    double share = 0.0;
     for (int t = 1; t < threads; ++t) {
-      const double target = cost[blocks] * t / threads;
+      share += paceOf(t - 1) / pace;
+      const double target = cost[blocks] * share;
       while (b < blocks && cost[b] < target) ++b;
       B.range[t] = std::min(n, b * kBlockRows);
+    }
+    B.thread_cost.assign(threads, 0.0);
+    for (int t = 0; t < threads; ++t) {
+      const auto block = [&](std::size_t r) { return (r + kBlockRows - 1) / kBlockRows; };
+      B.thread_cost[t] = cost[block(B.range[t + 1])] - cost[block(B.range[t])];
+    }
+  }
+
+  // Each thread's pace from the step's seconds in its rows: a fifth of the new reading, so a
+  // step the system interrupted moves the split little.
+  void updatePace(int threads) {
+    auto& B = buffers_;
+    for (int t = 0; t < threads; ++t) {
+      if (B.thread_cost[t] <= 0.0 || B.thread_seconds[t] <= 0.0) continue;
+      const double measured = B.thread_cost[t] / B.thread_seconds[t];
+      double& pace = B.thread_pace[t];
+      pace = pace > 0.0 ? 0.8 * pace + 0.2 * measured : measured;
     }
   }
 
@@ -371,6 +402,7 @@ class ContactModelImpl final : public ContactModel<D> {
     B.own_cross_row.resize(threads);
     B.cross_start.assign(threads + 1, 0);
     B.thread_over.assign(threads, 0);
+    B.thread_seconds.assign(threads, 0.0);
     const PairView v = viewOf(pass);
     V* force = P.force.data();
     A* torque = P.torque.data();
@@ -409,6 +441,7 @@ class ContactModelImpl final : public ContactModel<D> {
         }
         B.cross_start[threads] = B.cross.size();
         B.cross_result.resize(B.cross.size());
+        B.cross_index.resize(C.pairs.pairs());  // only the cross pairs' entries are read
       }
       // The cross pairs first, shared out evenly (the runs' boundaries hold most of them),
       // the touching ones four per register like the rows' (a pair's result does not depend
@@ -430,6 +463,7 @@ class ContactModelImpl final : public ContactModel<D> {
         const auto keep = [&](int k, std::uint32_t, std::uint32_t, const V& f, const A& ti,
                               const A& tj) { store(B.cross_result[slot[k]], f, ti, tj); };
         for (std::size_t g = first; g < last; ++g) {
+          B.cross_index[B.cross[g]] = static_cast<std::uint32_t>(g);
           KeptContact<D>& c = B.cross_result[g];
           c.diss = {};
           const std::uint32_t i = B.cross_row[g], p = B.cross[g];
@@ -450,13 +484,13 @@ class ContactModelImpl final : public ContactModel<D> {
 #pragma omp barrier  // every cross pair is ready before the partners' shares are read
 
       // The partners' shares of lower threads' cross pairs come first ...
+      const double rows_start = omp_get_wtime();
       const std::uint32_t first_pair = row[lo];
       for (std::size_t k = lo; k < hi; ++k) {
         for (std::uint32_t q = C.partner_row[k]; q < C.partner_row[k + 1]; ++q) {
           const std::uint32_t p = C.partner_pair[q];
           if (p >= first_pair) break;
-          const auto g = std::lower_bound(B.cross.begin(), B.cross.end(), p) - B.cross.begin();
-          const KeptContact<D>& c = B.cross_result[g];
+          const KeptContact<D>& c = B.cross_result[B.cross_index[p]];
           if (!c.touching) continue;
           force[k] += c.f.force;
           torque[k] -= c.f.torque_j;
@@ -486,7 +520,9 @@ class ContactModelImpl final : public ContactModel<D> {
         storeBlock(b, diss, over);
         B.block_touching[b] = touching;
       }
+      B.thread_seconds[t] = omp_get_wtime() - rows_start;
     }
+    updatePace(threads);
     addBlockSums(pass, blocks);
     for (std::uint8_t over : B.thread_over) pass.overlap_exceeded |= over != 0;
   }

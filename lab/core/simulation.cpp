@@ -5,6 +5,8 @@
 
 #include "lab/core/simulation.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -18,17 +20,29 @@ namespace rocklab {
 namespace {
 
 // Runs body(i, acc) over [0, n) in fixed blocks of kBlockRows and adds the blocks' partial
-// results in block order: the total is the same whatever the thread count.
+// results in block order: the total is the same whatever the thread count. Each thread takes
+// the run of blocks it took in the last contact pass (`rows`, ContactModel::threadRows), so
+// the particle data stays in its core's cache and a slower core keeps its smaller share;
+// without such runs (one thread, no threaded pass yet, a changed count), even runs.
 template <class Acc, class Body>
-Acc blockedSum(std::size_t n, int threads, Body body) {
+Acc blockedSum(std::size_t n, int threads, const std::vector<std::size_t>& rows, Body body) {
   const std::size_t blocks = (n + kBlockRows - 1) / kBlockRows;
   std::vector<Acc> part(blocks);
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::size_t b = 0; b < blocks; ++b) {
-    Acc a{};
-    const std::size_t end = std::min(n, (b + 1) * kBlockRows);
-    for (std::size_t i = b * kBlockRows; i < end; ++i) body(i, a);
-    part[b] = a;
+#pragma omp parallel num_threads(threads) if (threads > 1)
+  {
+    // The team may be smaller than asked (a thread limit): then even runs over the team.
+    const auto team = static_cast<std::size_t>(omp_get_num_threads());
+    const auto t = static_cast<std::size_t>(omp_get_thread_num());
+    const bool follow = rows.size() == team + 1 && rows.back() == n;
+    const std::size_t first = follow ? (rows[t] + kBlockRows - 1) / kBlockRows : t * blocks / team;
+    const std::size_t last =
+        follow ? (rows[t + 1] + kBlockRows - 1) / kBlockRows : (t + 1) * blocks / team;
+    for (std::size_t b = first; b < last; ++b) {
+      Acc a{};
+      const std::size_t end = std::min(n, (b + 1) * kBlockRows);
+      for (std::size_t i = b * kBlockRows; i < end; ++i) body(i, a);
+      part[b] = a;
+    }
   }
   Acc total{};
   for (const Acc& a : part) total.merge(a);
@@ -241,12 +255,13 @@ void Simulation<D>::applyGravity(double dt) {
     double work = 0.0;
     void merge(const Acc& o) { work += o.work; }
   };
-  const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
-    if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) return;  // clumps: whole bodies
-    const V f = g / P.physical_inv_mass[i];  // the weight: density scaling adds only inertia
-    P.force[i] += f;
-    a.work += f.dot(P.vel[i]) * dt;  // exact over the drift x += v dt
-  });
+  const Acc acc =
+      blockedSum<Acc>(P.size(), config_.threads, model_->threadRows(), [&](std::size_t i, Acc& a) {
+        if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) return;  // clumps: whole bodies
+        const V f = g / P.physical_inv_mass[i];  // the weight: density scaling adds only inertia
+        P.force[i] += f;
+        a.work += f.dot(P.vel[i]) * dt;  // exact over the drift x += v dt
+      });
   ledger_.body_work += acc.work;
   ledger_.positive_input += std::max(acc.work, 0.0);
 }
@@ -258,12 +273,13 @@ void Simulation<D>::applyForces(double dt) {
     double work = 0.0;
     void merge(const Acc& o) { work += o.work; }
   };
-  const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
-    const std::uint32_t slot = P.slot_of[i];
-    if (slot >= applied_.size() || P.inv_mass[i] == 0.0) return;
-    P.force[i] += applied_[slot];  // a pebble's share reaches its clump with its force
-    a.work += applied_[slot].dot(P.vel[i]) * dt;  // exact over the drift x += v dt
-  });
+  const Acc acc =
+      blockedSum<Acc>(P.size(), config_.threads, model_->threadRows(), [&](std::size_t i, Acc& a) {
+        const std::uint32_t slot = P.slot_of[i];
+        if (slot >= applied_.size() || P.inv_mass[i] == 0.0) return;
+        P.force[i] += applied_[slot];  // a pebble's share reaches its clump with its force
+        a.work += applied_[slot].dot(P.vel[i]) * dt;  // exact over the drift x += v dt
+      });
   ledger_.body_work += acc.work;
   ledger_.positive_input += std::max(acc.work, 0.0);
 }
@@ -278,22 +294,23 @@ void Simulation<D>::initialIntegrate() {
     void merge(const Acc& o) { vmax2 = std::max(vmax2, o.vmax2); }
   };
   const bool clumped = hasClumps();
-  const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
-    if (clumped && P.body[i] != kNoBody) return;  // pebbles move with their clump
-    V f = P.force[i];
-    A t = P.torque[i];
-    if (damped) {
-      f += damp_force_[i];
-      t += damp_torque_[i];
-    }
-    const V v = P.vel[i] + (h * P.inv_mass[i]) * f;
-    P.vel[i] = v;
-    P.spin[i] += (h * P.inv_inertia[i]) * t;
-    P.pos[i] += dt * v;
-    P.force[i].setZero();
-    P.torque[i] = angZero<A>();
-    a.vmax2 = std::max(a.vmax2, v.squaredNorm());
-  });
+  const Acc acc =
+      blockedSum<Acc>(P.size(), config_.threads, model_->threadRows(), [&](std::size_t i, Acc& a) {
+        if (clumped && P.body[i] != kNoBody) return;  // pebbles move with their clump
+        V f = P.force[i];
+        A t = P.torque[i];
+        if (damped) {
+          f += damp_force_[i];
+          t += damp_torque_[i];
+        }
+        const V v = P.vel[i] + (h * P.inv_mass[i]) * f;
+        P.vel[i] = v;
+        P.spin[i] += (h * P.inv_inertia[i]) * t;
+        P.pos[i] += dt * v;
+        P.force[i].setZero();
+        P.torque[i] = angZero<A>();
+        a.vmax2 = std::max(a.vmax2, v.squaredNorm());
+      });
   double vmax = std::sqrt(acc.vmax2);
   if (clumped) integrateClumpsFirstHalf(vmax);
   contacts_.particle_travel += vmax * dt;
@@ -321,37 +338,38 @@ void Simulation<D>::finalIntegrate() {
     }
   };
   const bool clumped = hasClumps();
-  const Acc acc = blockedSum<Acc>(P.size(), config_.threads, [&](std::size_t i, Acc& a) {
-    if (clumped && P.body[i] != kNoBody) return;
-    const double im = P.inv_mass[i], ii = P.inv_inertia[i];
-    if (im == 0.0) {
-      // A fixed particle moves with its prescribed velocity and works on its neighbours
-      // like a wall: minus the force they exert on it, times its velocity.
-      a.driven -= (P.force[i].dot(P.vel[i]) + angDot(P.torque[i], P.spin[i])) * dt;
-      return;
-    }
-    V f = P.force[i];
-    A t = P.torque[i];
-    V v = P.vel[i];
-    A w = P.spin[i];
-    V fd = V::Zero();
-    A td = angZero<A>();
-    if (damped) {
-      fd = localDamping(f, v, alpha);
-      td = localDamping(t, w, alpha);
-      damp_force_[i] = fd;
-      damp_torque_[i] = td;
-      f += fd;
-      t += td;
-    }
-    v += (h * im) * f;
-    w += (h * ii) * t;
-    P.vel[i] = v;
-    P.spin[i] = w;
-    a.ke_t += 0.5 * v.squaredNorm() / im;
-    a.ke_r += 0.5 * angDot(w, w) / ii;
-    if (damped) a.damping -= (fd.dot(v) + angDot(td, w)) * dt;
-  });
+  const Acc acc =
+      blockedSum<Acc>(P.size(), config_.threads, model_->threadRows(), [&](std::size_t i, Acc& a) {
+        if (clumped && P.body[i] != kNoBody) return;
+        const double im = P.inv_mass[i], ii = P.inv_inertia[i];
+        if (im == 0.0) {
+          // A fixed particle moves with its prescribed velocity and works on its neighbours
+          // like a wall: minus the force they exert on it, times its velocity.
+          a.driven -= (P.force[i].dot(P.vel[i]) + angDot(P.torque[i], P.spin[i])) * dt;
+          return;
+        }
+        V f = P.force[i];
+        A t = P.torque[i];
+        V v = P.vel[i];
+        A w = P.spin[i];
+        V fd = V::Zero();
+        A td = angZero<A>();
+        if (damped) {
+          fd = localDamping(f, v, alpha);
+          td = localDamping(t, w, alpha);
+          damp_force_[i] = fd;
+          damp_torque_[i] = td;
+          f += fd;
+          t += td;
+        }
+        v += (h * im) * f;
+        w += (h * ii) * t;
+        P.vel[i] = v;
+        P.spin[i] = w;
+        a.ke_t += 0.5 * v.squaredNorm() / im;
+        a.ke_r += 0.5 * angDot(w, w) / ii;
+        if (damped) a.damping -= (fd.dot(v) + angDot(td, w)) * dt;
+      });
   kinetic_ = acc.ke_t + acc.ke_r;
   ledger_.local_damping += acc.damping;
   if (clumped) {
