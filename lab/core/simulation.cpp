@@ -49,6 +49,15 @@ Acc blockedSum(std::size_t n, int threads, const std::vector<std::size_t>& rows,
   return total;
 }
 
+// A threaded step pays for its fork, joins and barriers and for the buffers its threads share
+// (about 40 us a step on the 2-core virtual machine of the benchmarks: the bench scene on 300
+// spheres took 28-36 us a step on one thread, 53-67 on two), so on a small sample a second
+// thread slows the step: two threads against one, medians of 7 alternating rounds, 1,000
+// spheres 0.87x, 1,500 0.91x, 2,000 1.10x, 3,000 1.14x. The particle passes therefore take a
+// thread per 1,000 particles at most. The bond pass keeps config.threads (a bond costs more
+// than a particle's share of the step, and it was not measured here).
+constexpr std::size_t kParticlesPerThread = 1000;
+
 std::uint64_t packId(ParticleId id) {
   return std::uint64_t{id.slot} << 32 | id.generation;
 }
@@ -219,6 +228,13 @@ void Simulation<D>::restartEnergyLedger() {
 }
 
 template <int D>
+int Simulation<D>::particleThreads() const {
+  const auto most = static_cast<int>(std::min<std::size_t>(
+      particles_.size() / kParticlesPerThread, static_cast<std::size_t>(config_.threads)));
+  return std::max(most, 1);
+}
+
+template <int D>
 bool Simulation<D>::computeForces(double history_dt) {
   const bool gravity = config_.gravity[0] != 0.0 || config_.gravity[1] != 0.0 ||
                        (D == 3 && config_.gravity[2] != 0.0);
@@ -231,8 +247,8 @@ bool Simulation<D>::computeForces(double history_dt) {
                       contacts_,
                       walls_,
                       history_dt,
-                      threaded(),
-                      config_.threads,
+                      particleThreads() > 1,
+                      particleThreads(),
                       config_.track_energy,
                       config_.guard.overlap_limit,
                       config_.contact_lane_width};
@@ -255,8 +271,8 @@ void Simulation<D>::applyGravity(double dt) {
     double work = 0.0;
     void merge(const Acc& o) { work += o.work; }
   };
-  const Acc acc =
-      blockedSum<Acc>(P.size(), config_.threads, model_->threadRows(), [&](std::size_t i, Acc& a) {
+  const Acc acc = blockedSum<Acc>(
+      P.size(), particleThreads(), model_->threadRows(), [&](std::size_t i, Acc& a) {
         if (P.inv_mass[i] == 0.0 || P.body[i] != kNoBody) return;  // clumps: whole bodies
         const V f = g / P.physical_inv_mass[i];  // the weight: density scaling adds only inertia
         P.force[i] += f;
@@ -273,8 +289,8 @@ void Simulation<D>::applyForces(double dt) {
     double work = 0.0;
     void merge(const Acc& o) { work += o.work; }
   };
-  const Acc acc =
-      blockedSum<Acc>(P.size(), config_.threads, model_->threadRows(), [&](std::size_t i, Acc& a) {
+  const Acc acc = blockedSum<Acc>(
+      P.size(), particleThreads(), model_->threadRows(), [&](std::size_t i, Acc& a) {
         const std::uint32_t slot = P.slot_of[i];
         if (slot >= applied_.size() || P.inv_mass[i] == 0.0) return;
         P.force[i] += applied_[slot];  // a pebble's share reaches its clump with its force
@@ -294,23 +310,24 @@ void Simulation<D>::initialIntegrate() {
     void merge(const Acc& o) { vmax2 = std::max(vmax2, o.vmax2); }
   };
   const bool clumped = hasClumps();
-  const Acc acc =
-      blockedSum<Acc>(P.size(), config_.threads, model_->threadRows(), [&](std::size_t i, Acc& a) {
-        if (clumped && P.body[i] != kNoBody) return;  // pebbles move with their clump
-        V f = P.force[i];
-        A t = P.torque[i];
-        if (damped) {
-          f += damp_force_[i];
-          t += damp_torque_[i];
-        }
-        const V v = P.vel[i] + (h * P.inv_mass[i]) * f;
-        P.vel[i] = v;
-        P.spin[i] += (h * P.inv_inertia[i]) * t;
-        P.pos[i] += dt * v;
-        P.force[i].setZero();
-        P.torque[i] = angZero<A>();
-        a.vmax2 = std::max(a.vmax2, v.squaredNorm());
-      });
+  const Acc acc = blockedSum<Acc>(P.size(), particleThreads(), model_->threadRows(),
+                                  [&](std::size_t i, Acc& a) {
+                                    if (clumped && P.body[i] != kNoBody)
+                                      return;  // pebbles move with their clump
+                                    V f = P.force[i];
+                                    A t = P.torque[i];
+                                    if (damped) {
+                                      f += damp_force_[i];
+                                      t += damp_torque_[i];
+                                    }
+                                    const V v = P.vel[i] + (h * P.inv_mass[i]) * f;
+                                    P.vel[i] = v;
+                                    P.spin[i] += (h * P.inv_inertia[i]) * t;
+                                    P.pos[i] += dt * v;
+                                    P.force[i].setZero();
+                                    P.torque[i] = angZero<A>();
+                                    a.vmax2 = std::max(a.vmax2, v.squaredNorm());
+                                  });
   double vmax = std::sqrt(acc.vmax2);
   if (clumped) integrateClumpsFirstHalf(vmax);
   contacts_.particle_travel += vmax * dt;
@@ -338,8 +355,8 @@ void Simulation<D>::finalIntegrate() {
     }
   };
   const bool clumped = hasClumps();
-  const Acc acc =
-      blockedSum<Acc>(P.size(), config_.threads, model_->threadRows(), [&](std::size_t i, Acc& a) {
+  const Acc acc = blockedSum<Acc>(
+      P.size(), particleThreads(), model_->threadRows(), [&](std::size_t i, Acc& a) {
         if (clumped && P.body[i] != kNoBody) return;
         const double im = P.inv_mass[i], ii = P.inv_inertia[i];
         if (im == 0.0) {

@@ -396,6 +396,9 @@ class Simulation {
   template <class F>
   void forEachTouching(F&& visit) const;
   bool threaded() const { return config_.threads > 1; }
+  // Threads of the per-particle passes (contacts, integration): config.threads, but one per
+  // kParticlesPerThread particles at most (simulation.cpp says why).
+  int particleThreads() const;
 
   MaterialTable materials_;
   SimulationConfig config_;

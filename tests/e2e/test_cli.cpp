@@ -50,10 +50,12 @@ TEST(Cli, HelpListsCommands) {
   }
 }
 
+// 2,000 spheres: the particle passes take a thread per 1,000 particles at most, so fewer would
+// run the serial pass on both.
 TEST(Cli, BenchGivesTheSameStateOnOneAndTwoThreads) {
   const auto packing = tempPath("bench.txt");
   const auto r =
-      run("bench --n 600 --steps 60 --warmup 10 --threads 1,2 --json --save-packing " + packing);
+      run("bench --n 2000 --steps 60 --warmup 10 --threads 1,2 --json --save-packing " + packing);
   ASSERT_EQ(r.status, 0) << r.out;
   std::regex hash("\"state_hash\": \"([0-9a-f]+)\"");
   std::vector<std::string> hashes;
