@@ -72,9 +72,9 @@ struct PairBuffers {
   std::vector<double> block_friction, block_viscous, block_cost;
   std::vector<std::uint32_t> block_touching;  // touching pairs per block, last threaded step
   // Each thread's pace in its rows (split cost per second), smoothed over the steps, and the
-  // cost and seconds of its rows in the last step: the split follows the pace of the core
-  // each thread ran on (threadedPairLoop).
-  std::vector<double> thread_pace, thread_cost, thread_seconds;
+  // seconds of its rows in the last step: the split follows the pace of the core each thread
+  // ran on (threadedPairLoop).
+  std::vector<double> thread_pace, thread_seconds;
   std::vector<std::uint8_t> block_over, thread_over;
 };
 

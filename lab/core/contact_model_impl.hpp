@@ -367,20 +367,17 @@ class ContactModelImpl final : public ContactModel<D> {
       while (b < blocks && cost[b] < target) ++b;
       B.range[t] = std::min(n, b * kBlockRows);
     }
-    B.thread_cost.assign(threads, 0.0);
-    for (int t = 0; t < threads; ++t) {
-      const auto block = [&](std::size_t r) { return (r + kBlockRows - 1) / kBlockRows; };
-      B.thread_cost[t] = cost[block(B.range[t + 1])] - cost[block(B.range[t])];
-    }
   }
 
-  // Each thread's pace from the step's seconds in its rows: a fifth of the new reading, so a
-  // step the system interrupted moves the split little.
+  // Each thread's pace from the cost of its run (splitRows) and the step's seconds in it: a
+  // fifth of the new reading, so a step the system interrupted moves the split little.
   void updatePace(int threads) {
     auto& B = buffers_;
+    const auto block = [](std::size_t r) { return (r + kBlockRows - 1) / kBlockRows; };
     for (int t = 0; t < threads; ++t) {
-      if (B.thread_cost[t] <= 0.0 || B.thread_seconds[t] <= 0.0) continue;
-      const double measured = B.thread_cost[t] / B.thread_seconds[t];
+      const double cost = B.block_cost[block(B.range[t + 1])] - B.block_cost[block(B.range[t])];
+      if (cost <= 0.0 || B.thread_seconds[t] <= 0.0) continue;
+      const double measured = cost / B.thread_seconds[t];
       double& pace = B.thread_pace[t];
       pace = pace > 0.0 ? 0.8 * pace + 0.2 * measured : measured;
     }

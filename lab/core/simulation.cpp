@@ -54,8 +54,9 @@ Acc blockedSum(std::size_t n, int threads, const std::vector<std::size_t>& rows,
 // spheres took 28-36 us a step on one thread, 53-67 on two), so on a small sample a second
 // thread slows the step: two threads against one, medians of 7 alternating rounds, 1,000
 // spheres 0.87x, 1,500 0.91x, 2,000 1.10x, 3,000 1.14x. The particle passes therefore take a
-// thread per 1,000 particles at most. The bond pass keeps config.threads (a bond costs more
-// than a particle's share of the step, and it was not measured here).
+// thread per 1,000 particles at most. The bond pass keeps config.threads: the same limit for
+// it (one thread below 40,000 bonds) left the 2D quick UCS protocol's bond pass as slow, its
+// particles having last been written on the other core (132 and 146 s against 157 and 147 s).
 constexpr std::size_t kParticlesPerThread = 1000;
 
 std::uint64_t packId(ParticleId id) {
